@@ -1,0 +1,12 @@
+//! `tyrekit diagnose` — arguments and dispatch. (Placeholder until its issue lands.)
+
+/// Arguments of `tyrekit diagnose`.
+#[derive(clap::Args, Debug)]
+pub struct Args {}
+
+/// Run the command.
+pub fn run(_args: Args) -> crate::Result<()> {
+    Err(crate::Error::Other(
+        "'tyrekit diagnose' is not implemented yet".into(),
+    ))
+}

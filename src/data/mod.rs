@@ -1,0 +1,1 @@
+//! data — placeholder; see the issue that owns it.

@@ -1,0 +1,1 @@
+//! diagnose — placeholder; see the issue that owns it.

@@ -1,0 +1,1 @@
+//! fit — placeholder; see the issue that owns it.

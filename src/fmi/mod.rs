@@ -1,0 +1,1 @@
+//! fmi — placeholder; see the issue that owns it.

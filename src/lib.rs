@@ -1,0 +1,24 @@
+//! tyrekit — a Magic Formula tyre model with transient dynamics, shipped as an
+//! FMI 2.0 co-simulation FMU, plus tools that read tyre test recordings, fit the
+//! model to them and diagnose why simulation and measurement differ.
+//!
+//! Data flows one way:
+//! recordings ([`data`]) → ISO-W SI samples → model ([`tir`], [`mf`], [`transient`])
+//! → residuals ([`fit`]) → report ([`diagnose`]).
+//!
+//! Conventions: ISO-W (TYDEX W) axes and SI units everywhere inside the crate.
+//! Conversions happen only at the edges (`.tir` `[UNITS]`, SAE/TTC recordings).
+
+pub mod bench;
+pub mod cli;
+pub mod data;
+pub mod diagnose;
+pub mod error;
+pub mod fit;
+pub mod fmi;
+pub mod mf;
+pub mod rig;
+pub mod tir;
+pub mod transient;
+
+pub use error::{Error, Result};

@@ -1,0 +1,1 @@
+//! rig — placeholder; see the issue that owns it.

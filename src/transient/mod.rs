@@ -1,0 +1,1 @@
+//! transient — placeholder; see the issue that owns it.

@@ -448,6 +448,29 @@ pub fn key_def(name: &str) -> Option<&'static KeyDef> {
     key_index(name).map(|i| &KEYS[i])
 }
 
+/// Other spellings of table keys that mean exactly the same parameter:
+/// `(alias, key of the table)`. Only true synonyms belong here.
+///
+/// `LFZ0` (digit zero) is how several tools spell `LFZO` (letter O).
+///
+/// Deliberately NOT aliases: the legacy spellings `QFZ2`, `QFZ3`, `QV1`, `QV2`,
+/// `QFCX1`, `QFCY1`, `QRE0` … of `Q_FZ2`, `Q_V1`, … MFeval 4.0 ignores them
+/// (it uses its default Q_FZ2 = 1e-4 for a file that says `QFZ2 = 15.4`), and
+/// tyrekit must reproduce MFeval's results, so they stay unknown keys: the
+/// reader keeps them (and the writer writes them back) but does not use them.
+pub const ALIASES: [(&str, &str); 1] = [("LFZ0", "LFZO")];
+
+/// Index of a key in [`KEYS`] (case-insensitive), accepting the synonyms of
+/// [`ALIASES`]. This is what the `.tir` reader uses.
+pub fn lookup_key(name: &str) -> Option<usize> {
+    key_index(name).or_else(|| {
+        ALIASES
+            .iter()
+            .find(|(alias, _)| alias.eq_ignore_ascii_case(name))
+            .and_then(|(_, key)| key_index(key))
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

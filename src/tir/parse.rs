@@ -203,15 +203,15 @@ impl TirDoc {
         &mut self.sections[i]
     }
 
-    /// First entry named `key` in any section (case-insensitive), with its section name.
+    /// The entry named `key` (case-insensitive) in any section, with its
+    /// section name; when there are several, the one latest in the file
+    /// (highest line), as the reader's "later wins" rule.
     pub fn find(&self, key: &str) -> Option<(&str, &Entry)> {
-        self.sections.iter().find_map(|s| {
-            s.entries
-                .iter()
-                .rev()
-                .find(|e| e.key.eq_ignore_ascii_case(key))
-                .map(|e| (s.name.as_str(), e))
-        })
+        self.sections
+            .iter()
+            .flat_map(|s| s.entries.iter().map(move |e| (s.name.as_str(), e)))
+            .filter(|(_, e)| e.key.eq_ignore_ascii_case(key))
+            .max_by_key(|(_, e)| e.line)
     }
 }
 

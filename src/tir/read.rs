@@ -64,12 +64,15 @@ pub fn read(text: &str, file: &str) -> Result<ReadOut> {
             if e.key.eq_ignore_ascii_case("TYRESIDE") {
                 if side_line != 0 {
                     warnings.push(format!(
-                        "line {}: TYRESIDE given again (first at line {side_line}); the later value is used",
-                        e.line
+                        "line {}: TYRESIDE given again (first at line {}); the later value is used",
+                        side_line.max(e.line),
+                        side_line.min(e.line)
                     ));
                 }
-                side_line = e.line;
-                side = parse_side(&e.value, e.line, &mut warnings);
+                if e.line >= side_line {
+                    side_line = e.line;
+                    side = parse_side(&e.value, e.line, &mut warnings);
+                }
                 continue;
             }
             let Some(i) = lookup_key(&e.key) else {
@@ -85,14 +88,19 @@ pub fn read(text: &str, file: &str) -> Result<ReadOut> {
             }
             match e.value {
                 Value::Number(x) => {
+                    // Later in the file wins (sections met twice are merged
+                    // into their first place, so compare lines, not order).
+                    let (first, later) = (given[i].min(e.line), given[i].max(e.line));
                     if given[i] != 0 {
                         warnings.push(format!(
-                            "line {}: {} given again (first at line {}); the later value is used",
-                            e.line, def.name, given[i]
+                            "line {later}: {} given again (first at line {first}); the later value is used",
+                            def.name
                         ));
                     }
-                    p.as_mut_slice()[i] = units.to_si(def.dim, x);
-                    given[i] = e.line;
+                    if e.line >= given[i] {
+                        p.as_mut_slice()[i] = units.to_si(def.dim, x);
+                        given[i] = e.line;
+                    }
                 }
                 Value::Empty => warnings.push(format!(
                     "line {}: {}: empty value, expected a number; treated as not given ({})",

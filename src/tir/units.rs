@@ -39,18 +39,21 @@ impl UnitKind {
         }
     }
 
+    /// Every kind, in the order the writer puts them in `[UNITS]`.
+    pub const ALL: [UnitKind; 6] = [
+        UnitKind::Length,
+        UnitKind::Force,
+        UnitKind::Angle,
+        UnitKind::Mass,
+        UnitKind::Time,
+        UnitKind::Pressure,
+    ];
+
     /// The kind named by a `[UNITS]` key (case-insensitive).
     pub fn from_key(key: &str) -> Option<Self> {
-        [
-            UnitKind::Length,
-            UnitKind::Force,
-            UnitKind::Angle,
-            UnitKind::Mass,
-            UnitKind::Time,
-            UnitKind::Pressure,
-        ]
-        .into_iter()
-        .find(|k| k.key().eq_ignore_ascii_case(key))
+        Self::ALL
+            .into_iter()
+            .find(|k| k.key().eq_ignore_ascii_case(key))
     }
 
     /// The SI unit name the writer puts in `[UNITS]`.

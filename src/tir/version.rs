@@ -156,7 +156,15 @@ pub fn detect(doc: &TirDoc, file: &str, warnings: &mut Vec<String>) -> Result<Mf
 
     // 2. FITTYP.
     let mut fittyp_version = None;
-    if let Some((_, e)) = doc.find("FITTYP") {
+    // As the reader does: the latest FITTYP that is a number (a later
+    // non-numeric one is not used).
+    let fittyp = doc
+        .sections
+        .iter()
+        .flat_map(|s| s.entries.iter())
+        .filter(|e| e.key.eq_ignore_ascii_case("FITTYP"))
+        .max_by_key(|e| (matches!(e.value, Value::Number(_)), e.line));
+    if let Some(e) = fittyp {
         match e.value {
             Value::Number(x) => match from_fittyp(x) {
                 Some(v) => fittyp_version = Some((v, x, e.line)),
@@ -182,9 +190,11 @@ pub fn detect(doc: &TirDoc, file: &str, warnings: &mut Vec<String>) -> Result<Mf
     // 3. Is there any Magic Formula coefficient?
     let has_coefficients = doc.sections.iter().any(|s| {
         s.entries.iter().any(|e| {
-            lookup_key(&e.key)
-                .map(|i| MF_COEFF_SECTIONS.contains(&KEYS[i].section))
-                .unwrap_or(false)
+            // Only a value the reader will use counts (`PDY1 =` does not).
+            matches!(e.value, Value::Number(_))
+                && lookup_key(&e.key)
+                    .map(|i| MF_COEFF_SECTIONS.contains(&KEYS[i].section))
+                    .unwrap_or(false)
         })
     });
     if !has_coefficients {

@@ -179,14 +179,7 @@ pub fn to_tir_string(t: &TyreParams) -> String {
     // [UNITS]
     separator(&mut out, "units");
     out.push_str("[UNITS]\n");
-    for k in [
-        UnitKind::Length,
-        UnitKind::Force,
-        UnitKind::Angle,
-        UnitKind::Mass,
-        UnitKind::Time,
-        UnitKind::Pressure,
-    ] {
+    for k in UnitKind::ALL {
         line(&mut out, k.key(), &format!("'{}'", k.si_name()), "");
     }
     if let Some(s) = doc.section("UNITS") {

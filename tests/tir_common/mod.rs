@@ -6,9 +6,17 @@ use std::path::PathBuf;
 
 /// `../shared/data/tir` relative to the crate root, if present.
 pub fn tir_dir() -> Option<PathBuf> {
+    // `../shared` from the project root; `../../shared` when the crate is a
+    // git worktree one level further down (work/wt/<branch>).
     let d = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/tir"));
+    let d2 = PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../shared/data/tir"
+    ));
     if d.is_dir() {
         Some(d)
+    } else if d2.is_dir() {
+        Some(d2)
     } else {
         eprintln!(
             "SKIP: {} is absent, so the tests over the shared .tir files do not run",

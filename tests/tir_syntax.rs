@@ -260,7 +260,7 @@ fn every_number_round_trips_bit_exactly() {
         1.0 / 3.0,
         2.0f64.sqrt(),
         -7.742e-4,
-        123456789.123456789,
+        123_456_789.123_456_78,
     ];
     let mut t = TyreParams::builtin();
     for (i, &x) in values.iter().enumerate() {

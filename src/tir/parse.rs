@@ -177,6 +177,9 @@ pub struct TirDoc {
     /// Sections in order of first appearance; a section that appears twice
     /// is merged into its first occurrence (with a warning).
     pub sections: Vec<Section>,
+    /// Trailing `$` comments of the keys of the key table (whose values live
+    /// in `MfParams`), by key name, so the writer can put them back.
+    pub key_comments: std::collections::BTreeMap<String, String>,
 }
 
 impl TirDoc {
@@ -219,7 +222,7 @@ impl TirDoc {
 /// `D` exponents; only finite values count as numbers.
 pub fn parse_number(s: &str) -> Option<f64> {
     let s = s.trim();
-    if s.is_empty() || s.len() > 64 {
+    if s.is_empty() {
         return None;
     }
     // Only plain decimal syntax: refuse "inf", "nan", "infinity" that Rust accepts.

@@ -57,6 +57,7 @@ pub fn read(text: &str, file: &str) -> Result<ReadOut> {
     let mut side = TyreSide::default();
     let mut side_line = 0usize;
     let mut unconverted: Vec<String> = Vec::new();
+    let mut comments: Vec<(&'static str, String)> = Vec::new();
 
     for sec in doc.sections.iter_mut() {
         let entries = std::mem::take(&mut sec.entries);
@@ -100,6 +101,9 @@ pub fn read(text: &str, file: &str) -> Result<ReadOut> {
                     if e.line >= given[i] {
                         p.as_mut_slice()[i] = units.to_si(def.dim, x);
                         given[i] = e.line;
+                        if !e.comment.is_empty() {
+                            comments.push((def.name, e.comment));
+                        }
                     }
                 }
                 Value::Empty => warnings.push(format!(
@@ -126,6 +130,9 @@ pub fn read(text: &str, file: &str) -> Result<ReadOut> {
             }
         }
         convert_table(sec, &units, &mut warnings);
+    }
+    for (k, c) in comments {
+        doc.key_comments.insert(k.to_string(), c);
     }
     if !unconverted.is_empty() {
         warnings.push(format!(

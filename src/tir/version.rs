@@ -31,11 +31,14 @@ const MF_COEFF_SECTIONS: [&str; 6] = [
 
 /// Version of a FITTYP value, if it is one tyrekit evaluates.
 pub fn from_fittyp(f: f64) -> Option<MfVersion> {
-    match f {
-        x if x == 5.0 || x == 6.0 || x == 52.0 => Some(MfVersion::Mf52),
-        x if x == 61.0 => Some(MfVersion::Mf61),
-        x if x == 62.0 => Some(MfVersion::Mf62),
-        _ => None,
+    if f == 5.0 || f == 6.0 || f == 52.0 {
+        Some(MfVersion::Mf52)
+    } else if f == 61.0 {
+        Some(MfVersion::Mf61)
+    } else if f == 62.0 {
+        Some(MfVersion::Mf62)
+    } else {
+        None
     }
 }
 

@@ -203,8 +203,8 @@ pub fn to_tir_string(t: &TyreParams) -> String {
         } else if let Some(s) = kept {
             entries(&mut out, s);
         }
-        for j in i..end {
-            key_line(&mut out, t, j, values[j]);
+        for (j, &x) in values.iter().enumerate().take(end).skip(i) {
+            key_line(&mut out, t, j, x);
         }
         if let Some(s) = kept {
             rest_of_section(&mut out, s);
@@ -289,7 +289,8 @@ fn key_line(out: &mut String, t: &TyreParams, j: usize, x: f64) {
             fmt_num(x)
         );
     } else if x.is_finite() {
-        line(out, k.name, &fmt_num(x), "");
+        let comment = t.doc.key_comments.get(k.name).map_or("", String::as_str);
+        line(out, k.name, &fmt_num(x), comment);
     } else {
         let _ = writeln!(
             out,

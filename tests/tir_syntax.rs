@@ -60,6 +60,7 @@ fn empty_and_non_numeric_values_are_defaults_with_warnings() {
         .warnings
         .iter()
         .any(|w| w.starts_with("line 7:") && w.contains("MASS") && w.contains("\"kg\"")));
+    assert_eq!(t.invalid, vec![("WIDTH", 4), ("MASS", 7)]);
 }
 
 #[test]
@@ -277,4 +278,20 @@ fn every_number_round_trips_bit_exactly() {
             Some(x.to_bits())
         );
     }
+}
+
+#[test]
+fn api_cannot_make_the_writer_write_a_key_twice() {
+    let mut t = TyreParams::builtin();
+    t.extra_section("UNITS").set("LENGTH", "mm");
+    t.extra_section("UNITS").set("NOTE", "kept");
+    t.extra_section("MODEL").set("TYRESIDE", "RIGHT");
+    t.extra_section("VERTICAL").set("FNOMIN", 1.0);
+    let back = read(&t.to_tir_string());
+    assert_eq!(back.p, t.p, "units stay SI, FNOMIN comes from p");
+    assert_eq!(back.side, TyreSide::Left, "TYRESIDE comes from `side`");
+    assert_eq!(
+        back.extra("UNITS", "NOTE").and_then(Value::as_str),
+        Some("kept")
+    );
 }

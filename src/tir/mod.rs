@@ -95,6 +95,11 @@ pub struct TyreParams {
     pub side: TyreSide,
     /// Names of the keys of [`KEYS`] that the file did not give (defaults used).
     pub defaulted: Vec<&'static str>,
+    /// Keys of [`KEYS`] the file gave with an empty or non-numeric value
+    /// (`WIDTH =`, `MASS = kg`), with their line: read as not given (MFeval
+    /// reads such values as NaN). Also in `defaulted` unless given validly
+    /// on another line.
+    pub invalid: Vec<(&'static str, usize)>,
     /// Warnings met while reading (duplicate keys, odd values …), with line numbers.
     pub warnings: Vec<String>,
     /// Where it came from (file path or a label).
@@ -127,6 +132,7 @@ impl TyreParams {
             p: r.p,
             side: r.side,
             defaulted: r.defaulted,
+            invalid: r.invalid,
             warnings: r.warnings,
             source: name.to_string(),
             doc: r.doc,
@@ -148,6 +154,7 @@ impl TyreParams {
                 },
                 side: TyreSide::Left,
                 defaulted: KEYS.iter().map(|k| k.name).collect(),
+                invalid: Vec::new(),
                 warnings: vec![format!(
                     "built-in file unreadable ({e}); table defaults used"
                 )],

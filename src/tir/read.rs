@@ -41,6 +41,7 @@ pub struct ReadOut {
     pub p: MfParams,
     pub side: TyreSide,
     pub defaulted: Vec<&'static str>,
+    pub invalid: Vec<(&'static str, usize)>,
     pub warnings: Vec<String>,
     pub doc: TirDoc,
 }
@@ -58,6 +59,7 @@ pub fn read(text: &str, file: &str) -> Result<ReadOut> {
     let mut side_line = 0usize;
     let mut unconverted: Vec<String> = Vec::new();
     let mut comments: Vec<(&'static str, String)> = Vec::new();
+    let mut invalid: Vec<(&'static str, usize)> = Vec::new();
 
     for sec in doc.sections.iter_mut() {
         let entries = std::mem::take(&mut sec.entries);
@@ -106,27 +108,18 @@ pub fn read(text: &str, file: &str) -> Result<ReadOut> {
                         }
                     }
                 }
-                Value::Empty => warnings.push(format!(
-                    "line {}: {}: empty value, expected a number; treated as not given ({})",
-                    e.line,
-                    def.name,
-                    if given[i] != 0 {
-                        format!("line {} kept", given[i])
-                    } else {
-                        format!("default {:?} used", def.default)
-                    }
-                )),
-                Value::Text(ref s) | Value::Word(ref s) => warnings.push(format!(
-                    "line {}: {}: expected a number, found {:?}; treated as not given ({})",
-                    e.line,
-                    def.name,
-                    truncate(s),
-                    if given[i] != 0 {
-                        format!("line {} kept", given[i])
-                    } else {
-                        format!("default {:?} used", def.default)
-                    }
-                )),
+                ref other => {
+                    let found = match other.as_str() {
+                        Some(s) => format!("found {:?}", truncate(s)),
+                        None => "found an empty value".to_string(),
+                    };
+                    warnings.push(format!(
+                        "line {}: {}: expected a number, {found}; treated as not given \
+                         (default {:?} unless the key is given elsewhere)",
+                        e.line, def.name, def.default
+                    ));
+                    invalid.push((def.name, e.line));
+                }
             }
         }
         convert_table(sec, &units, &mut warnings);
@@ -153,6 +146,7 @@ pub fn read(text: &str, file: &str) -> Result<ReadOut> {
         p,
         side,
         defaulted,
+        invalid,
         warnings,
         doc,
     })

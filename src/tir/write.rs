@@ -95,9 +95,14 @@ fn separator(out: &mut String, label: &str) {
 }
 
 fn entries(out: &mut String, sec: &Section) {
+    let units = sec.name.eq_ignore_ascii_case("UNITS");
     for e in &sec.entries {
-        // Keys of the table live in `p`; writing them here too would make a duplicate.
-        if super::keys::lookup_key(&e.key).is_some() || e.key.eq_ignore_ascii_case("TYRESIDE") {
+        // Keys of the table live in `p`, TYRESIDE in `side`, the units are
+        // written SI above: writing them here too would make a duplicate.
+        if super::keys::lookup_key(&e.key).is_some()
+            || e.key.eq_ignore_ascii_case("TYRESIDE")
+            || (units && UnitKind::from_key(&e.key).is_some())
+        {
             continue;
         }
         line(

@@ -166,6 +166,11 @@ impl TyreParams {
 
     /// Render as `.tir` text (SI units); reads back to bit-identical `p`,
     /// the same `version`, `side` and `defaulted`, and the kept document.
+    ///
+    /// Keys listed in `defaulted` whose value is still the default are
+    /// written as `$` comments (so they stay "not given"); a non-finite value
+    /// in `p` (NaN/inf, which no file can hold) is written as a comment too
+    /// and reads back as the default. See [`mod@write`] for the layout.
     pub fn to_tir_string(&self) -> String {
         write::to_tir_string(self)
     }

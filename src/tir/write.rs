@@ -53,8 +53,9 @@ fn sanitize_name(s: &str) -> String {
             }
         })
         .collect();
-    if t.is_empty() {
-        "_".to_string()
+    // A line starting with `(` would be read as a verbatim block.
+    if t.is_empty() || t.starts_with('(') {
+        format!("_{t}")
     } else {
         t
     }

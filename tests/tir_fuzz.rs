@@ -173,3 +173,33 @@ fn mutated_files_never_panic_and_what_is_accepted_round_trips() {
         "mutations too destructive to test the writer: {ok} accepted"
     );
 }
+
+#[test]
+fn random_bytes_never_panic() {
+    let mut rng = ChaCha8Rng::seed_from_u64(42);
+    // Bytes drawn mostly from the characters that matter to the lexer.
+    const ALPHABET: &[u8] = b"[]{}()=$!'\"\r\n\t .-+eEdD0123456789FITYPABCLMNOQRSUWXZ_\xff\xfe\x80";
+    for iter in 0..1500 {
+        let len = rng.gen_range(0..3000);
+        let b: Vec<u8> = (0..len)
+            .map(|_| {
+                if rng.gen_bool(0.9) {
+                    ALPHABET[rng.gen_range(0..ALPHABET.len())]
+                } else {
+                    rng.gen()
+                }
+            })
+            .collect();
+        let r = std::panic::catch_unwind(|| {
+            TyreParams::from_bytes(&b, "random.tir").map(|t| t.to_tir_string())
+        });
+        if r.is_err() {
+            let dump = std::env::temp_dir().join(format!("tir_random_{iter}.tir"));
+            let _ = std::fs::write(&dump, &b);
+            panic!(
+                "iteration {iter}: panicked; input saved to {}",
+                dump.display()
+            );
+        }
+    }
+}

@@ -196,3 +196,36 @@ fn non_si_file_round_trips_through_si() {
     assert_eq!(back.p, t.p);
     assert_eq!(back.extra_number("CUSTOM", "FOO"), Some(3.0));
 }
+
+#[test]
+fn implausible_converted_values_are_reported() {
+    // NOMPRES written in Pa in a millimetre file without PRESSURE key: read
+    // as N/mm^2 (ADAMS convention), which gives 2.2e11 Pa: warned, not refused.
+    let t = TyreParams::from_tir_str(
+        &fixture(
+            "LENGTH = 'mm'\nFORCE = 'newton'",
+            "NOMPRES = 220000\nUNLOADED_RADIUS = 313.5",
+        ),
+        "mm.tir",
+    )
+    .unwrap();
+    check(t.p.nompres, 2.2e11, "N/mm^2");
+    let w: Vec<_> = t
+        .warnings
+        .iter()
+        .filter(|w| w.contains("NOMPRES") && w.contains("outside"))
+        .collect();
+    assert_eq!(w.len(), 1, "{:?}", t.warnings);
+    assert!(
+        w[0].starts_with("line 8:") && w[0].contains("no PRESSURE key"),
+        "{}",
+        w[0]
+    );
+    assert!(
+        !t.warnings
+            .iter()
+            .any(|w| w.contains("UNLOADED_RADIUS") && w.contains("outside")),
+        "{:?}",
+        t.warnings
+    );
+}

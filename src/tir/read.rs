@@ -124,6 +124,7 @@ pub fn read(text: &str, file: &str) -> Result<ReadOut> {
         }
         convert_table(sec, &units, &mut warnings);
     }
+    plausibility(&p, &given, &units, &mut warnings);
     for (k, c) in comments {
         doc.key_comments.insert(k.to_string(), c);
     }
@@ -311,6 +312,35 @@ fn convert_table(sec: &mut Section, units: &Units, warnings: &mut Vec<String>) {
             if let Some(d) = d {
                 *x = units.to_si(*d, *x);
             }
+        }
+    }
+}
+
+/// Warn (never refuse) when a converted size, load or pressure is far outside
+/// anything a tyre has: the usual sign of a wrong `[UNITS]` section.
+fn plausibility(p: &MfParams, given: &[usize; N_KEYS], units: &Units, warnings: &mut Vec<String>) {
+    const RANGES: [(&str, f64, f64, &str); 4] = [
+        ("UNLOADED_RADIUS", 0.05, 5.0, "m"),
+        ("FNOMIN", 10.0, 1e6, "N"),
+        ("NOMPRES", 1e3, 1e8, "Pa"),
+        ("INFLPRES", 1e3, 1e8, "Pa"),
+    ];
+    for (name, lo, hi, unit) in RANGES {
+        let Some(i) = super::keys::key_index(name) else {
+            continue;
+        };
+        let x = p.as_slice()[i];
+        if given[i] != 0 && x != 0.0 && !(lo..=hi).contains(&x.abs()) {
+            let hint = if unit == "Pa" && units.pressure.is_none() {
+                " ([UNITS] has no PRESSURE key, so pressures are read in FORCE/LENGTH^2)"
+            } else {
+                ""
+            };
+            warnings.push(format!(
+                "line {}: {name} = {x} {unit} after [UNITS] conversion is outside {lo}..{hi} {unit}; \
+                 check the [UNITS] section{hint}",
+                given[i]
+            ));
         }
     }
 }

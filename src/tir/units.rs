@@ -71,11 +71,13 @@ impl UnitKind {
     /// Unit names this kind accepts, for error messages.
     pub fn accepted(self) -> &'static str {
         match self {
-            UnitKind::Length => "mm, cm, m/meter/metre, km, inch/in, ft/foot",
-            UnitKind::Force => "N/newton, kN, lbf/pound_force, kgf",
+            UnitKind::Length => "mm, cm, m/meter/metre, km, mile, inch/in, ft/foot",
+            UnitKind::Force => {
+                "N/newton, kN, mN, lbf/pound_force, kpound_force, ounce_force, kgf, dyne"
+            }
             UnitKind::Angle => "rad/radian/radians, deg/degree/degrees",
-            UnitKind::Mass => "kg, g, lbm/pound_mass, tonne",
-            UnitKind::Time => "s/sec/second, ms, min, h",
+            UnitKind::Mass => "kg, g, lbm/pound_mass, kpound_mass, ounce_mass, slug, tonne",
+            UnitKind::Time => "s/sec/second, ms/milli, min, h/hour",
             UnitKind::Pressure => "Pa/pascal, kPa, MPa, bar, psi",
         }
     }
@@ -91,6 +93,7 @@ impl UnitKind {
                 "cm" | "centimeter" | "centimeters" | "centimetre" | "centimetres" => 1e-2,
                 "m" | "meter" | "meters" | "metre" | "metres" => 1.0,
                 "km" | "kilometer" | "kilometers" | "kilometre" | "kilometres" => 1e3,
+                "mile" | "miles" => 5280.0 * 12.0 * INCH,
                 "in" | "inch" | "inches" => INCH,
                 "ft" | "foot" | "feet" => 12.0 * INCH,
                 _ => return None,
@@ -99,7 +102,11 @@ impl UnitKind {
                 "n" | "newton" | "newtons" => 1.0,
                 "kn" | "kilonewton" | "kilonewtons" => 1e3,
                 "lbf" | "pound_force" | "pounds_force" | "lb" | "lbs" => LBF,
+                "kpound_force" | "kip" | "kips" => 1e3 * LBF,
+                "ounce_force" | "ozf" => LBF / 16.0,
                 "kgf" | "kilogram_force" | "kp" => 9.806_65,
+                "millinewton" | "millinewtons" | "mn" => 1e-3,
+                "dyne" | "dynes" => 1e-5,
                 _ => return None,
             },
             UnitKind::Angle => match u {
@@ -111,13 +118,15 @@ impl UnitKind {
                 "kg" | "kilogram" | "kilograms" => 1.0,
                 "g" | "gram" | "grams" => 1e-3,
                 "lbm" | "pound_mass" | "pounds_mass" => 0.453_592_37,
+                "kpound_mass" => 453.592_37,
+                "ounce_mass" | "ounce" | "oz" => 0.453_592_37 / 16.0,
                 "tonne" | "tonnes" | "t" | "metric_ton" => 1e3,
                 "slug" | "slugs" => LBF / (12.0 * INCH),
                 _ => return None,
             },
             UnitKind::Time => match u {
                 "s" | "sec" | "secs" | "second" | "seconds" => 1.0,
-                "ms" | "millisecond" | "milliseconds" => 1e-3,
+                "ms" | "milli" | "millisecond" | "milliseconds" => 1e-3,
                 "min" | "minute" | "minutes" => 60.0,
                 "h" | "hr" | "hour" | "hours" => 3600.0,
                 _ => return None,
@@ -137,6 +146,14 @@ impl UnitKind {
 }
 
 /// SI factors of the five (six) base units of a file.
+///
+/// Unit names: those of the ADAMS tyre documentation ("Units Supported in
+/// Tire Property Files": METER, MM, CM, KM, MILE, FOOT, IN; NEWTON, POUND_FORCE,
+/// KPOUND_FORCE, KILOGRAM_FORCE, OUNCE_FORCE, DYNE; KG, GRAM, POUND_MASS,
+/// KPOUND_MASS, SLUG, OUNCE_MASS; SEC, MILLI, MIN, HOUR; RAD, DEG) and the
+/// usual spellings found in files (`'newton'`, `'Newton'`, `'radians'`,
+/// `'second'`, `'pascal'`, …), case-insensitive. `PRESSURE` is not an ADAMS
+/// unit key but appears in files (`'pascal'`, `'Pascal'`) and is honoured.
 ///
 /// Pressure: when `[UNITS]` names no `PRESSURE`, pressures are taken in
 /// FORCE/LENGTH² as ADAMS does (Pa for an SI file, N/mm² = MPa for an

@@ -156,8 +156,13 @@ fn root_rl(
         return f64::NAN;
     }
     const N: usize = 256;
+    // At Rl = Rω the free-rolling deflection is 0 and so is Fz62 (the camber
+    // term aside); use −Fz there so that 0·∞ in (ρ/R0)^Q_FCY2 cannot hide it.
     let mut hi = romega;
     let mut fhi = f(hi);
+    if !(fhi < 0.0) && gamma == 0.0 {
+        fhi = -fz;
+    }
     let mut lo = f64::NAN;
     for i in 1..=N {
         let x = romega * (1.0 - 0.99 * i as f64 / N as f64);

@@ -16,17 +16,159 @@ use std::time::Instant;
 
 /// Keys the Python implementation needs (MF 6.1 combined slip, no turn slip).
 const PY_KEYS: &[&str] = &[
-    "FNOMIN", "UNLOADED_RADIUS", "LONGVL", "NOMPRES", "FZMIN", "LFZO", "LCX", "LMUX", "LEX", "LKX", "LHX", "LVX", "LCY",
-    "LMUY", "LEY", "LKY", "LKYC", "LKZC", "LHY", "LVY", "LTR", "LRES", "LXAL", "LYKA", "LVYKA", "LS", "LMX", "LVMX", "LMY",
-    "PCX1", "PDX1", "PDX2", "PDX3", "PEX1", "PEX2", "PEX3", "PEX4", "PKX1", "PKX2", "PKX3", "PHX1", "PHX2", "PVX1", "PVX2",
-    "PPX1", "PPX2", "PPX3", "PPX4", "RBX1", "RBX2", "RBX3", "RCX1", "REX1", "REX2", "RHX1", "QSX1", "QSX2", "QSX3", "QSX4",
-    "QSX5", "QSX6", "QSX7", "QSX8", "QSX9", "QSX10", "QSX11", "QSX12", "QSX13", "QSX14", "PPMX1", "PCY1", "PDY1", "PDY2",
-    "PDY3", "PEY1", "PEY2", "PEY3", "PEY4", "PEY5", "PKY1", "PKY2", "PKY3", "PKY4", "PKY5", "PKY6", "PKY7", "PHY1", "PHY2",
-    "PVY1", "PVY2", "PVY3", "PVY4", "PPY1", "PPY2", "PPY3", "PPY4", "PPY5", "RBY1", "RBY2", "RBY3", "RBY4", "RCY1", "REY1",
-    "REY2", "RHY1", "RHY2", "RVY1", "RVY2", "RVY3", "RVY4", "RVY5", "RVY6", "QSY1", "QSY2", "QSY3", "QSY4", "QSY5", "QSY6",
-    "QSY7", "QSY8", "QBZ1", "QBZ2", "QBZ3", "QBZ4", "QBZ5", "QBZ9", "QBZ10", "QCZ1", "QDZ1", "QDZ2", "QDZ3", "QDZ4", "QDZ6",
-    "QDZ7", "QDZ8", "QDZ9", "QDZ10", "QDZ11", "QEZ1", "QEZ2", "QEZ3", "QEZ4", "QEZ5", "QHZ1", "QHZ2", "QHZ3", "QHZ4", "PPZ1",
-    "PPZ2", "SSZ1", "SSZ2", "SSZ3", "SSZ4",
+    "FNOMIN",
+    "UNLOADED_RADIUS",
+    "LONGVL",
+    "NOMPRES",
+    "FZMIN",
+    "LFZO",
+    "LCX",
+    "LMUX",
+    "LEX",
+    "LKX",
+    "LHX",
+    "LVX",
+    "LCY",
+    "LMUY",
+    "LEY",
+    "LKY",
+    "LKYC",
+    "LKZC",
+    "LHY",
+    "LVY",
+    "LTR",
+    "LRES",
+    "LXAL",
+    "LYKA",
+    "LVYKA",
+    "LS",
+    "LMX",
+    "LVMX",
+    "LMY",
+    "PCX1",
+    "PDX1",
+    "PDX2",
+    "PDX3",
+    "PEX1",
+    "PEX2",
+    "PEX3",
+    "PEX4",
+    "PKX1",
+    "PKX2",
+    "PKX3",
+    "PHX1",
+    "PHX2",
+    "PVX1",
+    "PVX2",
+    "PPX1",
+    "PPX2",
+    "PPX3",
+    "PPX4",
+    "RBX1",
+    "RBX2",
+    "RBX3",
+    "RCX1",
+    "REX1",
+    "REX2",
+    "RHX1",
+    "QSX1",
+    "QSX2",
+    "QSX3",
+    "QSX4",
+    "QSX5",
+    "QSX6",
+    "QSX7",
+    "QSX8",
+    "QSX9",
+    "QSX10",
+    "QSX11",
+    "QSX12",
+    "QSX13",
+    "QSX14",
+    "PPMX1",
+    "PCY1",
+    "PDY1",
+    "PDY2",
+    "PDY3",
+    "PEY1",
+    "PEY2",
+    "PEY3",
+    "PEY4",
+    "PEY5",
+    "PKY1",
+    "PKY2",
+    "PKY3",
+    "PKY4",
+    "PKY5",
+    "PKY6",
+    "PKY7",
+    "PHY1",
+    "PHY2",
+    "PVY1",
+    "PVY2",
+    "PVY3",
+    "PVY4",
+    "PPY1",
+    "PPY2",
+    "PPY3",
+    "PPY4",
+    "PPY5",
+    "RBY1",
+    "RBY2",
+    "RBY3",
+    "RBY4",
+    "RCY1",
+    "REY1",
+    "REY2",
+    "RHY1",
+    "RHY2",
+    "RVY1",
+    "RVY2",
+    "RVY3",
+    "RVY4",
+    "RVY5",
+    "RVY6",
+    "QSY1",
+    "QSY2",
+    "QSY3",
+    "QSY4",
+    "QSY5",
+    "QSY6",
+    "QSY7",
+    "QSY8",
+    "QBZ1",
+    "QBZ2",
+    "QBZ3",
+    "QBZ4",
+    "QBZ5",
+    "QBZ9",
+    "QBZ10",
+    "QCZ1",
+    "QDZ1",
+    "QDZ2",
+    "QDZ3",
+    "QDZ4",
+    "QDZ6",
+    "QDZ7",
+    "QDZ8",
+    "QDZ9",
+    "QDZ10",
+    "QDZ11",
+    "QEZ1",
+    "QEZ2",
+    "QEZ3",
+    "QEZ4",
+    "QEZ5",
+    "QHZ1",
+    "QHZ2",
+    "QHZ3",
+    "QHZ4",
+    "PPZ1",
+    "PPZ2",
+    "SSZ1",
+    "SSZ2",
+    "SSZ3",
+    "SSZ4",
 ];
 
 /// Varied inputs inside the tyre's ranges, above VXLOW (so use mode 111
@@ -70,7 +212,9 @@ pub fn run(ctx: &BenchContext) -> crate::Result<()> {
     let n = if ctx.quick { 20_000 } else { 200_000 };
     let reps = if ctx.quick { 3 } else { 7 };
     let inp = inputs(&tyre, n);
-    println!("[mf] built-in MF 6.1 tyre, use mode 111, {n} varied inputs, one core, best of {reps}");
+    println!(
+        "[mf] built-in MF 6.1 tyre, use mode 111, {n} varied inputs, one core, best of {reps}"
+    );
     let sum = |f: Forces| f.fx + f.fy + f.mx + f.my + f.mz;
     let ns_forces = time_ns(&inp, reps, |x| sum(tyre.forces(x, mode)));
     let ns_eval = time_ns(&inp, reps, |x| tyre.evaluate(x, mode).re);
@@ -89,20 +233,36 @@ fn python_peers(ctx: &BenchContext, tyre: &Tyre, mode: UseMode, inp: &[MfInput],
     };
     let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("python/bench_mf.py");
     if !script.exists() {
-        println!("[mf] skipped: Python peers ({} not found)", script.display());
+        println!(
+            "[mf] skipped: Python peers ({} not found)",
+            script.display()
+        );
         return;
     }
     let dir = std::env::temp_dir().join(format!("tyrekit-bench-mf-{}", std::process::id()));
     if let Err(e) = std::fs::create_dir_all(&dir) {
-        println!("[mf] skipped: Python peers (cannot create {}: {e})", dir.display());
+        println!(
+            "[mf] skipped: Python peers (cannot create {}: {e})",
+            dir.display()
+        );
         return;
     }
     let p = &tyre.params().p;
-    let params: serde_json::Map<String, serde_json::Value> =
-        PY_KEYS.iter().map(|k| (k.to_string(), serde_json::json!(p.get(k).unwrap_or(f64::NAN)))).collect();
+    let params: serde_json::Map<String, serde_json::Value> = PY_KEYS
+        .iter()
+        .map(|k| {
+            (
+                k.to_string(),
+                serde_json::json!(p.get(k).unwrap_or(f64::NAN)),
+            )
+        })
+        .collect();
     let mut csv = String::from("Fz,kappa,alpha,gamma,Vx,P\n");
     for x in inp {
-        csv.push_str(&format!("{:?},{:?},{:?},{:?},{:?},{:?}\n", x.fz, x.kappa, x.alpha, x.gamma, x.vx, x.p));
+        csv.push_str(&format!(
+            "{:?},{:?},{:?},{:?},{:?},{:?}\n",
+            x.fz, x.kappa, x.alpha, x.gamma, x.vx, x.p
+        ));
     }
     let (pj, ic) = (dir.join("params.json"), dir.join("inputs.csv"));
     let written = std::fs::write(&pj, serde_json::Value::Object(params).to_string())
@@ -111,20 +271,35 @@ fn python_peers(ctx: &BenchContext, tyre: &Tyre, mode: UseMode, inp: &[MfInput],
         println!("[mf] skipped: Python peers (cannot write inputs: {e})");
         return;
     }
-    let out = std::process::Command::new(py).arg(&script).arg(&pj).arg(&ic).arg(if ctx.quick { "3" } else { "7" }).output();
+    let out = std::process::Command::new(py)
+        .arg(&script)
+        .arg(&pj)
+        .arg(&ic)
+        .arg(if ctx.quick { "3" } else { "7" })
+        .output();
     let _ = std::fs::remove_dir_all(&dir);
     let out = match out {
         Ok(o) => o,
         Err(e) => {
-            println!("[mf] skipped: Python peers (cannot run {}: {e})", py.display());
+            println!(
+                "[mf] skipped: Python peers (cannot run {}: {e})",
+                py.display()
+            );
             return;
         }
     };
     let text = String::from_utf8_lossy(&out.stdout);
-    let Some(json) = text.lines().rev().find_map(|l| serde_json::from_str::<serde_json::Value>(l).ok()) else {
+    let Some(json) = text
+        .lines()
+        .rev()
+        .find_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
+    else {
         println!(
             "[mf] skipped: Python peers (bench_mf.py gave no result: {})",
-            String::from_utf8_lossy(&out.stderr).lines().last().unwrap_or("")
+            String::from_utf8_lossy(&out.stderr)
+                .lines()
+                .last()
+                .unwrap_or("")
         );
         return;
     };

@@ -58,7 +58,10 @@ pub fn read_inputs(path: &Path) -> Result<Vec<MfInput>> {
         .trim(csv::Trim::All)
         .from_path(path)
         .map_err(|e| err(1, format!("cannot read: {e}")))?;
-    let header = rdr.headers().map_err(|e| err(1, format!("cannot read the header: {e}")))?.clone();
+    let header = rdr
+        .headers()
+        .map_err(|e| err(1, format!("cannot read the header: {e}")))?
+        .clone();
     let find = |n: &str| {
         header
             .iter()
@@ -90,7 +93,13 @@ pub fn read_inputs(path: &Path) -> Result<Vec<MfInput>> {
                 0.0
             } else {
                 parse_number(s).ok_or_else(|| {
-                    err(line, format!("column '{}': '{s}' is not a number", header.get(i).unwrap_or(name)))
+                    err(
+                        line,
+                        format!(
+                            "column '{}': '{s}' is not a number",
+                            header.get(i).unwrap_or(name)
+                        ),
+                    )
                 })?
             };
         }

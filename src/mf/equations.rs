@@ -16,7 +16,7 @@
 //! whose coefficient is exactly zero when no derivative is tracked.
 
 use super::limits::{Clamped, Conditions, EPS};
-use super::real::{abs, cap_one, pow, sign, sign1, Real};
+use super::real::{abs, cap_one, cos_atan, pow, sign, sign1, Real};
 use crate::tir::MfParams;
 use std::f64::consts::PI;
 
@@ -72,7 +72,11 @@ pub struct Model<T: Real = f64> {
     lgaz: T,
     /// Zero-coefficient shortcuts allowed (value-only evaluation).
     skip_pkx3: bool,
-    skip_my_pow: bool,
+    skip_qsy7: bool,
+    skip_qsy8: bool,
+    /// Mx terms with zero coefficients (value-only evaluation).
+    skip_mx_sin: bool,
+    skip_mx_atan: bool,
 }
 
 /// The pure-slip lateral force and the quantities the other equations reuse.
@@ -107,8 +111,11 @@ impl<T: Real> Model<T> {
         };
         let fz0p = p.lfzo * p.fnomin;
         let skip_pkx3 = !T::TRACKS_DERIVATIVES && p.pkx3.v() == 0.0;
-        let skip_my_pow =
-            !T::TRACKS_DERIVATIVES && p.qsy7.v() == 0.0 && p.qsy8.v() == 0.0 && form == Form::Mf6;
+        let zero = |x: T| !T::TRACKS_DERIVATIVES && x.v() == 0.0;
+        let skip_qsy7 = zero(p.qsy7);
+        let skip_qsy8 = zero(p.qsy8);
+        let skip_mx_sin = zero(p.qsx4) || (zero(p.qsx7) && zero(p.qsx8));
+        let skip_mx_atan = zero(p.qsx10);
         Model {
             p,
             form,
@@ -117,7 +124,10 @@ impl<T: Real> Model<T> {
             lgay,
             lgaz,
             skip_pkx3,
-            skip_my_pow,
+            skip_qsy7,
+            skip_qsy8,
+            skip_mx_sin,
+            skip_mx_atan,
         }
     }
 
@@ -212,10 +222,10 @@ impl<T: Real> Model<T> {
         let r0 = p.unloaded_radius;
         let (zeta2, zeta3) = match spin {
             Some(s) => {
-                let z3 = (p.pkyp1 * r0 * r0 * s.phi * s.phi).atan().cos(); // 4.79
-                let byp = p.pdyp1 * (p.pdyp2 * dfz + 1.0) * (p.pdyp3 * c.alpha.tan()).atan().cos(); // 4.78
+                let z3 = cos_atan(p.pkyp1 * r0 * r0 * s.phi * s.phi); // 4.79
+                let byp = p.pdyp1 * (p.pdyp2 * dfz + 1.0) * cos_atan(p.pdyp3 * c.alpha.tan()); // 4.78
                 let rphi = r0 * abs(s.phi);
-                let z2 = (byp * (rphi + p.pdyp4 * rphi.sqrt())).atan().cos(); // 4.77
+                let z2 = cos_atan(byp * (rphi + p.pdyp4 * rphi.sqrt())); // 4.77
                 (z2, z3)
             }
             None => (one, one),
@@ -296,15 +306,13 @@ impl<T: Real> Model<T> {
         }
     }
 
-    /// Combined-slip weighting Gyκ and κ-induced side force SVyκ (4.E58–4.E67).
-    fn gyk(&self, c: &Conditions, dfz: T, gs: T, muy: T, zeta2: T, fl: &mut u32) -> (T, T) {
+    /// Combined-slip weighting Gyκ (4.E59–4.E65) and the κ-induced side
+    /// force SVyκ per unit of μy·ζ2 (4.E66, 4.E67; SVyκ is linear in μy, so one
+    /// evaluation serves both the γ and the γ = 0 lateral force).
+    fn gyk(&self, c: &Conditions, dfz: T, gs: T, fl: &mut u32) -> (T, T) {
         let p = &self.p;
         let fz = T::c(c.fz);
-        let dvyk = muy
-            * fz
-            * (p.rvy1 + p.rvy2 * dfz + p.rvy3 * gs)
-            * (p.rvy4 * c.alpha_star).atan().cos()
-            * zeta2; // 4.E67
+        let dvyk = fz * (p.rvy1 + p.rvy2 * dfz + p.rvy3 * gs) * cos_atan(p.rvy4 * c.alpha_star); // 4.E67 / (μy ζ2)
         let svyk = dvyk * (p.rvy5 * (p.rvy6 * c.kappa).atan()).sin() * p.lvyka * c.smooth; // 4.E66
         let shyk = p.rhy1 + p.rhy2 * dfz; // 4.E65
         let (eyk, hit) = cap_one(p.rey1 + p.rey2 * dfz, c.mode.limits); // 4.E64
@@ -313,7 +321,7 @@ impl<T: Real> Model<T> {
         }
         let cyk = p.rcy1; // 4.E63
         let byk =
-            (p.rby1 + p.rby4 * gs * gs) * (p.rby2 * (-p.rby3 + c.alpha_star)).atan().cos() * p.lyka; // 4.E62
+            (p.rby1 + p.rby4 * gs * gs) * cos_atan(p.rby2 * (-p.rby3 + c.alpha_star)) * p.lyka; // 4.E62
         let ks = shyk + c.kappa; // 4.E61
         let g0 = byk * shyk;
         let gyk0 = (cyk * (g0 - eyk * (g0 - g0.atan())).atan()).cos(); // 4.E60
@@ -331,7 +339,7 @@ impl<T: Real> Model<T> {
             *fl |= Clamped::EXA;
         }
         let shxa = p.rhx1; // 4.E57
-        let bxa = (p.rbx1 + p.rbx3 * gsx * gsx) * (p.rbx2 * c.kappa).atan().cos() * p.lxal; // 4.E54
+        let bxa = (p.rbx1 + p.rbx3 * gsx * gsx) * cos_atan(p.rbx2 * c.kappa) * p.lxal; // 4.E54
         let a_s = shxa + c.alpha_star; // 4.E53
         let b0 = bxa * shxa;
         let gxa0 = (cxa * (b0 - exa * (b0 - b0.atan())).atan()).cos(); // 4.E52
@@ -354,14 +362,26 @@ impl<T: Real> Model<T> {
         let fyn = fy / fz0;
         let fzn = fz / fz0;
         let q6 = p.qsx6 * fzn;
+        // Terms with a zero coefficient are exactly 0 (skipped when no
+        // derivative is tracked).
+        let sin_term = if self.skip_mx_sin {
+            T::c(0.0)
+        } else {
+            p.qsx4
+                * (p.qsx5 * (q6 * q6).atan()).cos()
+                * (p.qsx7 * g + p.qsx8 * (p.qsx9 * fyn).atan()).sin()
+        };
+        let atan_term = if self.skip_mx_atan {
+            T::c(0.0)
+        } else {
+            p.qsx10 * (p.qsx11 * fzn).atan() * g
+        };
         r0 * fz
             * p.lmx
             * (p.qsx1 * p.lvmx - p.qsx2 * g * (p.ppmx1 * dpi + 1.0) - p.qsx12 * g * c.gamma.abs()
                 + p.qsx3 * fyn
-                + p.qsx4
-                    * (p.qsx5 * (q6 * q6).atan()).cos()
-                    * (p.qsx7 * g + p.qsx8 * (p.qsx9 * fyn).atan()).sin()
-                + p.qsx10 * (p.qsx11 * fzn).atan() * g)
+                + sin_term
+                + atan_term)
             + r0 * fy * p.lmx * (p.qsx13 + p.qsx14 * c.gamma.abs())
     }
 
@@ -383,11 +403,18 @@ impl<T: Real> Model<T> {
         } else {
             let g2 = c.gamma * c.gamma;
             let inner = speed + (p.qsy5 + p.qsy6 * (fz / fz0)) * g2;
-            let scale = if self.skip_my_pow {
+            // Zero exponents give exactly 1 (0^0 = 1 as in MATLAB).
+            let load = if self.skip_qsy7 {
                 T::c(1.0)
             } else {
-                pow(fz / fz0, p.qsy7) * pow(T::c(c.p) / p.nompres, p.qsy8)
+                pow(fz / fz0, p.qsy7)
             };
+            let press = if self.skip_qsy8 {
+                T::c(1.0)
+            } else {
+                pow(T::c(c.p) / p.nompres, p.qsy8)
+            };
+            let scale = load * press;
             -(p.unloaded_radius * fz0 * p.lmy * inner * scale)
         };
         if c.vx < 0.0 {
@@ -432,8 +459,8 @@ impl<T: Real> Model<T> {
 
         let zeta1 = match spin {
             Some(s) => {
-                let bxp = p.pdxp1 * (p.pdxp2 * dfz + 1.0) * (p.pdxp3 * c.kappa).atan().cos(); // 4.106
-                (bxp * r0 * s.phi).atan().cos() // 4.105
+                let bxp = p.pdxp1 * (p.pdxp2 * dfz + 1.0) * cos_atan(p.pdxp3 * c.kappa); // 4.106
+                cos_atan(bxp * r0 * s.phi) // 4.105
             }
             None => one,
         };
@@ -448,7 +475,7 @@ impl<T: Real> Model<T> {
         let alphar = shf + c.alpha_star; // 4.E37
         let alphat = sht + c.alpha_star; // 4.E34
         let zeta5 = match spin {
-            Some(s) => (p.qdtp1 * r0 * s.phi).atan().cos(), // 4.91
+            Some(s) => cos_atan(p.qdtp1 * r0 * s.phi), // 4.91
             None => one,
         };
         let dt = (p.qdz1 + p.qdz2 * dfz)
@@ -470,15 +497,15 @@ impl<T: Real> Model<T> {
             fl |= Clamped::ET;
         }
 
+        let (gyk, svyk_unit) = self.gyk(c, dfz, gs_y, &mut fl);
         let (fx, fy) = {
             let gxa = self.gxa(c, dfz, gs_x, &mut fl);
-            let (gyk, svyk) = self.gyk(c, dfz, gs_y, f.muy, f.zeta2, &mut fl);
-            (gxa * fx0, gyk * f.fy0 + svyk) // 4.E50, 4.E58
+            (gxa * fx0, gyk * f.fy0 + svyk_unit * f.muy * f.zeta2) // 4.E50, 4.E58
         };
 
         let (zeta0, zeta6, zeta7, zeta8) = match spin {
             Some(s) => {
-                let z6 = (p.qbrp1 * r0 * s.phi).atan().cos(); // 4.102
+                let z6 = cos_atan(p.qbrp1 * r0 * s.phi); // 4.102
                 let mut mzp_inf =
                     p.qcrp1 * abs(f.muy) * r0 * fzm * (fzm / self.fz0p).sqrt() * p.lmp; // 4.95
                 if mzp_inf.v() < 0.0 {
@@ -493,7 +520,6 @@ impl<T: Real> Model<T> {
                     * p.lkzc;
                 let bdrp = kzgr0 / (cdrp * ddrp * (-s.eps_g + 1.0));
                 let drp = ddrp * (cdrp * (bdrp * r0 * c.phit).atan()).sin();
-                let (gyk, _) = self.gyk(c, dfz, gs_y, f.muy, f.zeta2, &mut fl);
                 let mzp90 = mzp_inf * (2.0 / PI) * (p.qcrp2 * r0 * c.phit.abs()).atan() * gyk; // 4.103
                 let ratio = mzp90 / abs(drp);
                 // MATLAB's real(acos(x)) outside [−1, 1] is 0 or π.
@@ -533,9 +559,14 @@ impl<T: Real> Model<T> {
         let s = r0 * (p.ssz1 + p.ssz2 * (fy / p.fnomin) + (p.ssz3 + p.ssz4 * dfz) * g_z) * p.ls; // A56
         let mzr = dr * (cr * (br * ar_eq).atan()).cos() * c.smooth; // 4.E75
                                                                     // Fy at γ = 0 (and Gyκ with the original γ*, as MFeval does to match TNO).
-        let f0 = self.fy0(c, dfz, dpi, T::c(0.0), spin, &mut fl);
-        let (gyk0, svyk0) = self.gyk(c, dfz, gs_y, f0.muy, one, &mut fl);
-        let fy_prime = gyk0 * f0.fy0; // 4.E74
+        let f0 = if c.gamma_star == 0.0 {
+            // γ* = 0: the lateral force at γ = 0 is the one just computed.
+            f
+        } else {
+            self.fy0(c, dfz, dpi, T::c(0.0), spin, &mut fl)
+        };
+        let svyk0 = svyk_unit * f0.muy;
+        let fy_prime = gyk * f0.fy0; // 4.E74
         let bat = bt * at_eq;
         // 4.E73, multiplied by LFZO as TNO's solver does (found by MFeval).
         let t = dt

@@ -182,8 +182,11 @@ impl Conditions {
         };
         let mut fz_mz = fz;
         let mut smooth = 1.0;
+        let tan_alpha_in = alpha.tan();
         if mode.limits {
-            phit *= alpha.cos();
+            if phit != 0.0 {
+                phit *= alpha.cos();
+            }
             let vxlow = p.vxlow;
             if vx.abs() <= vxlow {
                 fl |= Clamped::LOW_SPEED;
@@ -197,7 +200,7 @@ impl Conditions {
             if vx < 0.0 {
                 phit = -phit;
             }
-            let vsy = alpha.tan() * vx;
+            let vsy = tan_alpha_in * vx;
             let ssum = vx.abs() + vsy.abs();
             if ssum < vxlow {
                 fl |= Clamped::LOW_SPEED_ALPHA;
@@ -249,16 +252,22 @@ impl Conditions {
             );
         }
         let alpha_out = if vx == 0.0 { 0.0 } else { inp.alpha };
+        // (cos α′ is Vcx/V′c itself; MFeval's cos(acos(·)) differs by an ulp.)
+        let tan_alpha = if alpha == inp.alpha {
+            tan_alpha_in
+        } else {
+            alpha.tan()
+        };
         let (alpha_star, gamma_star) = if mode.alpha_star {
-            (alpha.tan() * crate::mf::real::sign(vx), gamma.sin())
+            (tan_alpha * crate::mf::real::sign(vx), gamma.sin())
         } else {
             (alpha, gamma)
         };
         // Contact-centre speed and α′ (Pacejka eqs. 4.E6, 4.E6a), ε = 1e-6.
-        let vcy = alpha.tan() * vx.abs();
+        let vcy = tan_alpha * vx.abs();
         let vc = (vx * vx + vcy * vcy).sqrt();
         let vc_prime = vc + EPS * crate::mf::real::sign1(vc);
-        let cos_alpha_prime = (vx / vc_prime).acos().cos();
+        let cos_alpha_prime = vx / vc_prime;
         (
             Conditions {
                 fz,

@@ -101,3 +101,9 @@ pub fn cap_one<T: Real>(x: T, on: bool) -> (T, bool) {
         (x, false)
     }
 }
+
+/// cos(atan x) = 1/sqrt(1 + x²), without the two transcendental calls.
+#[inline(always)]
+pub fn cos_atan<T: Real>(x: T) -> T {
+    (x * x + 1.0).sqrt().recip()
+}

@@ -77,6 +77,7 @@ pub struct Model<T: Real = f64> {
     /// Mx terms with zero coefficients (value-only evaluation).
     skip_mx_sin: bool,
     skip_mx_atan: bool,
+    pky4_is_2: bool,
 }
 
 /// The pure-slip lateral force and the quantities the other equations reuse.
@@ -116,6 +117,7 @@ impl<T: Real> Model<T> {
         let skip_qsy8 = zero(p.qsy8);
         let skip_mx_sin = zero(p.qsx4) || (zero(p.qsx7) && zero(p.qsx8));
         let skip_mx_atan = zero(p.qsx10);
+        let pky4_is_2 = !T::TRACKS_DERIVATIVES && p.pky4.v() == 2.0;
         Model {
             p,
             form,
@@ -128,6 +130,7 @@ impl<T: Real> Model<T> {
             skip_qsy8,
             skip_mx_sin,
             skip_mx_atan,
+            pky4_is_2,
         }
     }
 
@@ -196,11 +199,17 @@ impl<T: Real> Model<T> {
     fn kya(&self, fz: T, dpi: T, gs: T, zeta3: T) -> T {
         let p = &self.p;
         let arg = (fz / self.fz0p) / ((p.pky2 + p.pky5 * gs * gs) * (p.ppy2 * dpi + 1.0));
+        // sin(2 atan x) = 2x/(1 + x²) for the usual PKY4 = 2 (value-only shortcut).
+        let shape = if self.pky4_is_2 {
+            arg * 2.0 / (arg * arg + 1.0)
+        } else {
+            (p.pky4 * arg.atan()).sin()
+        };
         p.pky1
             * self.fz0p
             * (p.ppy1 * dpi + 1.0)
             * (-(p.pky3 * abs(gs)) + 1.0)
-            * (p.pky4 * arg.atan()).sin()
+            * shape
             * zeta3
             * p.lky
     }
@@ -323,8 +332,12 @@ impl<T: Real> Model<T> {
         let byk =
             (p.rby1 + p.rby4 * gs * gs) * cos_atan(p.rby2 * (-p.rby3 + c.alpha_star)) * p.lyka; // 4.E62
         let ks = shyk + c.kappa; // 4.E61
-        let g0 = byk * shyk;
-        let gyk0 = (cyk * (g0 - eyk * (g0 - g0.atan())).atan()).cos(); // 4.E60
+        let gyk0 = if !T::TRACKS_DERIVATIVES && shyk.v() == 0.0 {
+            T::c(1.0) // cos(0)
+        } else {
+            let g0 = byk * shyk;
+            (cyk * (g0 - eyk * (g0 - g0.atan())).atan()).cos() // 4.E60
+        };
         let g = byk * ks;
         let gyk = (cyk * (g - eyk * (g - g.atan())).atan()).cos() / gyk0; // 4.E59
         (gyk, svyk)
@@ -341,8 +354,12 @@ impl<T: Real> Model<T> {
         let shxa = p.rhx1; // 4.E57
         let bxa = (p.rbx1 + p.rbx3 * gsx * gsx) * cos_atan(p.rbx2 * c.kappa) * p.lxal; // 4.E54
         let a_s = shxa + c.alpha_star; // 4.E53
-        let b0 = bxa * shxa;
-        let gxa0 = (cxa * (b0 - exa * (b0 - b0.atan())).atan()).cos(); // 4.E52
+        let gxa0 = if !T::TRACKS_DERIVATIVES && shxa.v() == 0.0 {
+            T::c(1.0) // cos(0)
+        } else {
+            let b0 = bxa * shxa;
+            (cxa * (b0 - exa * (b0 - b0.atan())).atan()).cos() // 4.E52
+        };
         let b = bxa * a_s;
         (cxa * (b - exa * (b - b.atan())).atan()).cos() / gxa0 // 4.E51
     }
@@ -521,7 +538,13 @@ impl<T: Real> Model<T> {
                 let bdrp = kzgr0 / (cdrp * ddrp * (-s.eps_g + 1.0));
                 let drp = ddrp * (cdrp * (bdrp * r0 * c.phit).atan()).sin();
                 let mzp90 = mzp_inf * (2.0 / PI) * (p.qcrp2 * r0 * c.phit.abs()).atan() * gyk; // 4.103
-                let ratio = mzp90 / abs(drp);
+                                                                                               // At φt = 0 both are 0; use the limit φt → 0 of the ratio
+                                                                                               // (MFeval gives 0/0 = NaN there: a deliberate difference).
+                let ratio = if drp.v() == 0.0 && c.phit == 0.0 {
+                    mzp_inf * (2.0 / PI) * p.qcrp2 * gyk / abs(ddrp * cdrp * bdrp)
+                } else {
+                    mzp90 / abs(drp)
+                };
                 // MATLAB's real(acos(x)) outside [−1, 1] is 0 or π.
                 let z7 = if ratio.v() > 1.0 {
                     T::c(0.0)

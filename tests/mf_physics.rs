@@ -3,17 +3,10 @@
 //! report. Expected values are computed here independently from the file's
 //! coefficients (never taken from the code under test).
 
-use std::path::{Path, PathBuf};
+mod common;
+use common::shared;
 use tyrekit::mf::{Clamped, MfInput, Tyre, UseMode};
 use tyrekit::tir::{MfVersion, TyreParams};
-
-fn shared() -> PathBuf {
-    let p = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared")).to_path_buf();
-    match std::env::var_os("TYREKIT_SHARED") {
-        Some(s) if !p.exists() => PathBuf::from(s),
-        _ => p,
-    }
-}
 
 const NO_LIMITS: UseMode = UseMode {
     limits: false,

@@ -17,6 +17,8 @@
 //!
 //! Skips with a message when the shared data is absent.
 
+mod common;
+use common::{num, shared};
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use tyrekit::mf::{MfInput, Tyre, UseMode, OUTPUT_COLUMNS};
@@ -47,26 +49,6 @@ const TOL: f64 = 1e-6;
 
 /// Deliberate differences: (file stem, columns, reason).
 const EXCLUDED: &[(&str, &[&str], &str)] = &[];
-
-/// `../shared` next to the crate, or `$TYREKIT_SHARED` (for worktrees that
-/// live elsewhere).
-fn shared() -> PathBuf {
-    let p = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared")).to_path_buf();
-    match std::env::var_os("TYREKIT_SHARED") {
-        Some(s) if !p.exists() => PathBuf::from(s),
-        _ => p,
-    }
-}
-
-fn parse(s: &str) -> f64 {
-    match s {
-        "NaN" => f64::NAN,
-        "Inf" => f64::INFINITY,
-        "-Inf" => f64::NEG_INFINITY,
-        "" => f64::NAN,
-        _ => s.parse().unwrap_or_else(|_| panic!("bad number {s:?}")),
-    }
-}
 
 /// Relative error measure used for the summary; Infinity when the
 /// finiteness differs.
@@ -99,7 +81,7 @@ fn read_csv(path: &Path) -> Table {
         .collect();
     let rows = lines
         .filter(|l| !l.is_empty())
-        .map(|l| l.split(',').map(parse).collect())
+        .map(|l| l.split(',').map(num).collect())
         .collect();
     Table { header, rows }
 }

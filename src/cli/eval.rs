@@ -62,11 +62,12 @@ pub fn read_inputs(path: &Path) -> Result<Vec<MfInput>> {
         .headers()
         .map_err(|e| err(1, format!("cannot read the header: {e}")))?
         .clone();
+    // `in_X` first: a reference CSV also has output columns named Fz, P, omega….
     let find = |n: &str| {
         header
             .iter()
-            .position(|h| h == n)
-            .or_else(|| header.iter().position(|h| h == format!("in_{n}")))
+            .position(|h| h == format!("in_{n}"))
+            .or_else(|| header.iter().position(|h| h == n))
     };
     let mut idx = [None; 8];
     for (k, (name, required)) in INPUTS.iter().enumerate() {

@@ -231,7 +231,7 @@ fn mfeval_reference() {
                 if e > m.0 || e.is_nan() {
                     *m = (e, r[c("row")] as usize);
                 }
-                if !(e <= TOL) {
+                if e.is_nan() || e > TOL {
                     bad += 1;
                     if bad <= 5 {
                         println!(

@@ -444,7 +444,7 @@ impl<T: Real> Model<T> {
         if k >= low && k <= high {
             // Linear ramp from 0 at κ = −1 to π/2 at κ = `high`.
             let red = (0.0 * (high - k) + PI / 2.0 * (k + 1.0)) / (high + 1.0);
-            my = my * red.sin();
+            my *= red.sin();
         }
         if k < low {
             my = -my;

@@ -152,7 +152,7 @@ fn root_rl(
     fy: f64,
 ) -> f64 {
     let f = |rl: f64| fz62(p, gamma, omega, romega, dpi, rl, fx, fy).0 - fz;
-    if !(romega > 0.0) {
+    if romega.is_nan() || romega <= 0.0 {
         return f64::NAN;
     }
     const N: usize = 256;
@@ -160,7 +160,7 @@ fn root_rl(
     // term aside); use −Fz there so that 0·∞ in (ρ/R0)^Q_FCY2 cannot hide it.
     let mut hi = romega;
     let mut fhi = f(hi);
-    if !(fhi < 0.0) && gamma == 0.0 {
+    if (fhi.is_nan() || fhi >= 0.0) && gamma == 0.0 {
         fhi = -fz;
     }
     let mut lo = f64::NAN;
@@ -194,9 +194,10 @@ fn root_rl(
 
 /// Contact patch half length a and half width b.
 ///
-/// MF 6.x: a = R0·(Q_RA2·Fz/(Cz R0) + Q_RA1·sqrt(Fz/(Cz R0))), b = w·(Q_RB2·Fz/(Cz R0)
-/// + Q_RB1·(Fz/(Cz R0))^(1/3)) (paper eqs. 9, 10). MF 5.2: a = R0·(Q_A2 Fz/Fz0 +
-/// Q_A1 sqrt(Fz/Fz0)), b = w/2; when the file has neither Q_A1 nor Q_A2,
+/// MF 6.x (paper eqs. 9, 10), with x = Fz/(Cz R0):
+/// a = R0·(Q_RA2·x + Q_RA1·sqrt(x)) and b = w·(Q_RB2·x + Q_RB1·x^(1/3)).
+/// MF 5.2: a = R0·(Q_A2·Fz/Fz0 + Q_A1·sqrt(Fz/Fz0)) and b = w/2; when the file
+/// has neither Q_A1 nor Q_A2,
 /// MFeval's empirical defaults from log10(R0 Cz0/Fz0). Beyond bottoming
 /// (R0 − Fz/Cz below RIM_RADIUS + BOTTOM_OFFST) the load is held at the
 /// bottoming load.

@@ -107,3 +107,19 @@ pub fn cap_one<T: Real>(x: T, on: bool) -> (T, bool) {
 pub fn cos_atan<T: Real>(x: T) -> T {
     (x * x + 1.0).sqrt().recip()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn helpers_follow_matlab() {
+        assert_eq!(sign(0.0), 0.0);
+        assert_eq!(sign1(0.0), 1.0);
+        assert_eq!(sign(-2.0), -1.0);
+        assert!(sign(f64::NAN).is_nan());
+        assert_eq!(pow(0.0, 0.0), 1.0);
+        assert_eq!(pow(num_dual::Dual64::from(0.0), num_dual::Dual64::from(0.85)).re, 0.0);
+        assert!((cos_atan(0.7) - 0.7f64.atan().cos()).abs() < 1e-16);
+    }
+}

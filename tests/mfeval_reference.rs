@@ -24,8 +24,10 @@ use std::path::{Path, PathBuf};
 use tyrekit::mf::{MfInput, Tyre, UseMode, OUTPUT_COLUMNS};
 use tyrekit::tir::TyreParams;
 
-/// Keys MFeval read as NaN (empty values in the file), from the notes.
-fn nan_keys(notes: &serde_json::Value, stem: &str) -> Vec<String> {
+/// Parameter values as MFeval read them where that can differ from our
+/// reader: empty values (NaN for MFeval) and missing keys (MFeval's
+/// defaults), from `mfeval_tir_notes.json`.
+fn mfeval_values(notes: &serde_json::Value, stem: &str) -> Vec<(String, f64)> {
     let entry = notes.as_object().and_then(|o| {
         o.iter()
             .find(|(k, _)| k.rsplit_once('.').map(|(s, _)| s) == Some(stem))
@@ -33,16 +35,27 @@ fn nan_keys(notes: &serde_json::Value, stem: &str) -> Vec<String> {
     let Some((_, v)) = entry else {
         return Vec::new();
     };
-    v["keys_read_as_NaN_or_changed"]
+    let mut out: Vec<(String, f64)> = v["keys_read_as_NaN_or_changed"]
         .as_array()
         .map(|a| {
             a.iter()
                 .filter_map(|s| s.as_str())
                 .filter(|s| s.ends_with("mfeval NaN"))
-                .filter_map(|s| s.split(':').next().map(|k| k.trim().to_string()))
+                .filter_map(|s| {
+                    s.split(':')
+                        .next()
+                        .map(|k| (k.trim().to_string(), f64::NAN))
+                })
                 .collect()
         })
-        .unwrap_or_default()
+        .unwrap_or_default();
+    if let Some(d) = v["keys_missing_mfeval_default_used"].as_object() {
+        out.extend(
+            d.iter()
+                .filter_map(|(k, x)| x.as_f64().map(|x| (k.clone(), x))),
+        );
+    }
+    out
 }
 
 const TOL: f64 = 1e-6;
@@ -126,9 +139,26 @@ fn mfeval_reference() {
         // (default, with a warning) for our reader: a deliberate difference of
         // the reader. To check the equations on every column anyway, such keys
         // are set to NaN here, as MFeval read them (`mfeval_tir_notes.json`).
+        // Likewise keys missing from the file take MFeval's built-in defaults,
+        // and keys MFeval does not know (legacy spellings such as QFZ2 in
+        // `sample`) must not act: applying MFeval's values makes this test
+        // check the equations whatever our reader decides for such keys (the
+        // reader has its own tests); any such difference is printed.
         let mut params = TyreParams::from_file(&tir).unwrap();
-        for key in nan_keys(&notes, stem) {
-            params.p.set(&key, f64::NAN);
+        let mut changed = Vec::new();
+        for (key, value) in mfeval_values(&notes, stem) {
+            if let Some(ours) = params.p.get(&key) {
+                if ours.to_bits() != value.to_bits() {
+                    changed.push(format!("{key} {ours}→{value}"));
+                    params.p.set(&key, value);
+                }
+            }
+        }
+        if !changed.is_empty() {
+            println!(
+                "  {name}: parameters set as MFeval read them: {}",
+                changed.join(", ")
+            );
         }
         let tyre = Tyre::new(params).unwrap();
         let is61 = tyre.version() == tyrekit::tir::MfVersion::Mf61;

@@ -119,7 +119,10 @@ mod tests {
         assert_eq!(sign(-2.0), -1.0);
         assert!(sign(f64::NAN).is_nan());
         assert_eq!(pow(0.0, 0.0), 1.0);
-        assert_eq!(pow(num_dual::Dual64::from(0.0), num_dual::Dual64::from(0.85)).re, 0.0);
+        assert_eq!(
+            pow(num_dual::Dual64::from(0.0), num_dual::Dual64::from(0.85)).re,
+            0.0
+        );
         assert!((cos_atan(0.7) - 0.7f64.atan().cos()).abs() < 1e-16);
     }
 }

@@ -66,6 +66,13 @@ pub struct Model<T: Real = f64> {
     pub form: Form,
     /// Fz0′ = LFZO·FNOMIN (4.E1).
     fz0p: T,
+    /// Reciprocals of parameters used as divisors (multiplication is cheaper).
+    inv_fz0p: T,
+    inv_fnomin: T,
+    inv_nompres: T,
+    inv_lmuy: T,
+    inv_longvl: T,
+    inv_fzmin: T,
     /// Camber scalings (1 except PAC2002).
     lgax: T,
     lgay: T,
@@ -119,6 +126,12 @@ impl<T: Real> Model<T> {
         let skip_mx_atan = zero(p.qsx10);
         let pky4_is_2 = !T::TRACKS_DERIVATIVES && p.pky4.v() == 2.0;
         Model {
+            inv_fz0p: fz0p.recip(),
+            inv_fnomin: p.fnomin.recip(),
+            inv_nompres: p.nompres.recip(),
+            inv_lmuy: p.lmuy.recip(),
+            inv_longvl: p.longvl.recip(),
+            inv_fzmin: p.fzmin.recip(),
             p,
             form,
             fz0p,
@@ -198,7 +211,7 @@ impl<T: Real> Model<T> {
     #[inline(always)]
     fn kya(&self, fz: T, dpi: T, gs: T, zeta3: T) -> T {
         let p = &self.p;
-        let arg = (fz / self.fz0p) / ((p.pky2 + p.pky5 * gs * gs) * (p.ppy2 * dpi + 1.0));
+        let arg = (fz * self.inv_fz0p) / ((p.pky2 + p.pky5 * gs * gs) * (p.ppy2 * dpi + 1.0));
         // sin(2 atan x) = 2x/(1 + x²) for the usual PKY4 = 2 (value-only shortcut).
         let shape = if self.pky4_is_2 {
             arg * 2.0 / (arg * arg + 1.0)
@@ -371,13 +384,13 @@ impl<T: Real> Model<T> {
         let p = &self.p;
         let mut fz = T::c(c.fz);
         if c.fz < p.fzmin.v() {
-            fz = fz * (fz / p.fzmin) * (fz / p.fzmin);
+            let r = fz * self.inv_fzmin;
+            fz = fz * r * r;
         }
         let g = T::c(c.gamma);
         let r0 = p.unloaded_radius;
-        let fz0 = p.fnomin;
-        let fyn = fy / fz0;
-        let fzn = fz / fz0;
+        let fyn = fy * self.inv_fnomin;
+        let fzn = fz * self.inv_fnomin;
         let q6 = p.qsx6 * fzn;
         // Terms with a zero coefficient are exactly 0 (skipped when no
         // derivative is tracked).
@@ -409,27 +422,28 @@ impl<T: Real> Model<T> {
         let p = &self.p;
         let mut fz = T::c(c.fz_u);
         if c.fz_u < p.fzmin.v() {
-            fz = fz * (fz / p.fzmin);
+            fz = fz * (fz * self.inv_fzmin);
         }
         let fz0 = p.fnomin;
-        let vr = T::c(c.vx) / p.longvl;
+        let vr = T::c(c.vx) * self.inv_longvl;
         let vr2 = vr * vr;
-        let speed = p.qsy1 + p.qsy2 * (fx / fz0) + p.qsy3 * abs(vr) + p.qsy4 * (vr2 * vr2);
+        let speed =
+            p.qsy1 + p.qsy2 * (fx * self.inv_fnomin) + p.qsy3 * abs(vr) + p.qsy4 * (vr2 * vr2);
         let mut my = if self.is52() {
             -(p.unloaded_radius * fz * p.lmy * speed)
         } else {
             let g2 = c.gamma * c.gamma;
-            let inner = speed + (p.qsy5 + p.qsy6 * (fz / fz0)) * g2;
+            let inner = speed + (p.qsy5 + p.qsy6 * (fz * self.inv_fnomin)) * g2;
             // Zero exponents give exactly 1 (0^0 = 1 as in MATLAB).
             let load = if self.skip_qsy7 {
                 T::c(1.0)
             } else {
-                pow(fz / fz0, p.qsy7)
+                pow(fz * self.inv_fnomin, p.qsy7)
             };
             let press = if self.skip_qsy8 {
                 T::c(1.0)
             } else {
-                pow(T::c(c.p) / p.nompres, p.qsy8)
+                pow(T::c(c.p) * self.inv_nompres, p.qsy8)
             };
             let scale = load * press;
             -(p.unloaded_radius * fz0 * p.lmy * inner * scale)
@@ -461,8 +475,8 @@ impl<T: Real> Model<T> {
         let mut fl = 0u32;
         let one = T::c(1.0);
         let fz = T::c(c.fz);
-        let dfz = (fz - self.fz0p) / self.fz0p; // 4.E2a
-        let dpi = (T::c(c.p) - p.nompres) / p.nompres; // 4.E2b
+        let dfz = (fz - self.fz0p) * self.inv_fz0p; // 4.E2a
+        let dpi = (T::c(c.p) - p.nompres) * self.inv_nompres; // 4.E2b
         let gs = T::c(c.gamma_star);
         let g = T::c(c.gamma);
         let (gs_y, gx, gs_z, g_z) = (gs * self.lgay, g * self.lgax, gs * self.lgaz, g * self.lgaz);
@@ -499,13 +513,13 @@ impl<T: Real> Model<T> {
             * (-(p.ppz1 * dpi) + 1.0)
             * (p.qdz3 * g_z + p.qdz4 * g_z * g_z + 1.0)
             * fzm
-            * (r0 / self.fz0p)
+            * (r0 * self.inv_fz0p)
             * p.ltr
             * zeta5; // A60
         let bt = (p.qbz1 + p.qbz2 * dfz + p.qbz3 * dfz * dfz)
             * (p.qbz4 * g_z + p.qbz5 * abs(g_z) + 1.0)
             * p.lky
-            / p.lmuy; // A58
+            * self.inv_lmuy; // A58
         let ct = p.qcz1; // 4.E41
         let et = (p.qez1 + p.qez2 * dfz + p.qez3 * dfz * dfz)
             * ((p.qez4 + p.qez5 * gs_z) * (2.0 / PI) * (bt * ct * alphat).atan() + 1.0); // 4.E44
@@ -571,7 +585,7 @@ impl<T: Real> Model<T> {
             * c.alpha_star.cos()
             + zeta8
             - 1.0; // 4.E47
-        let br = (p.qbz9 * p.lky / p.lmuy + p.qbz10 * f.by * f.cy) * zeta6; // 4.E45
+        let br = (p.qbz9 * p.lky * self.inv_lmuy + p.qbz10 * f.by * f.cy) * zeta6; // 4.E45
         let cr = zeta7; // 4.E46
 
         // Combined-slip aligning torque (4.E71–4.E78 with paper A54–A56).
@@ -579,7 +593,8 @@ impl<T: Real> Model<T> {
         let kk2 = kr * kr * (c.kappa * c.kappa);
         let ar_eq = (alphar.tan() * alphar.tan() + kk2).sqrt().atan() * sign(alphar); // A54
         let at_eq = (alphat.tan() * alphat.tan() + kk2).sqrt().atan() * sign(alphat); // A55
-        let s = r0 * (p.ssz1 + p.ssz2 * (fy / p.fnomin) + (p.ssz3 + p.ssz4 * dfz) * g_z) * p.ls; // A56
+        let s =
+            r0 * (p.ssz1 + p.ssz2 * (fy * self.inv_fnomin) + (p.ssz3 + p.ssz4 * dfz) * g_z) * p.ls; // A56
         let mzr = dr * (cr * (br * ar_eq).atan()).cos() * c.smooth; // 4.E75
                                                                     // Fy at γ = 0 (and Gyκ with the original γ*, as MFeval does to match TNO).
         let f0 = if c.gamma_star == 0.0 {

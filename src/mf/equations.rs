@@ -85,6 +85,8 @@ pub struct Model<T: Real = f64> {
     skip_mx_sin: bool,
     skip_mx_atan: bool,
     pky4_is_2: bool,
+    rcx1_is_1: bool,
+    rcy1_is_1: bool,
 }
 
 /// The pure-slip lateral force and the quantities the other equations reuse.
@@ -125,6 +127,8 @@ impl<T: Real> Model<T> {
         let skip_mx_sin = zero(p.qsx4) || (zero(p.qsx7) && zero(p.qsx8));
         let skip_mx_atan = zero(p.qsx10);
         let pky4_is_2 = !T::TRACKS_DERIVATIVES && p.pky4.v() == 2.0;
+        let rcx1_is_1 = !T::TRACKS_DERIVATIVES && p.rcx1.v() == 1.0;
+        let rcy1_is_1 = !T::TRACKS_DERIVATIVES && p.rcy1.v() == 1.0;
         Model {
             inv_fz0p: fz0p.recip(),
             inv_fnomin: p.fnomin.recip(),
@@ -144,6 +148,8 @@ impl<T: Real> Model<T> {
             skip_mx_sin,
             skip_mx_atan,
             pky4_is_2,
+            rcx1_is_1,
+            rcy1_is_1,
         }
     }
 
@@ -348,11 +354,9 @@ impl<T: Real> Model<T> {
         let gyk0 = if !T::TRACKS_DERIVATIVES && shyk.v() == 0.0 {
             T::c(1.0) // cos(0)
         } else {
-            let g0 = byk * shyk;
-            (cyk * (g0 - eyk * (g0 - g0.atan())).atan()).cos() // 4.E60
+            weight(self.rcy1_is_1, cyk, byk * shyk, eyk) // 4.E60
         };
-        let g = byk * ks;
-        let gyk = (cyk * (g - eyk * (g - g.atan())).atan()).cos() / gyk0; // 4.E59
+        let gyk = weight(self.rcy1_is_1, cyk, byk * ks, eyk) / gyk0; // 4.E59
         (gyk, svyk)
     }
 
@@ -370,11 +374,9 @@ impl<T: Real> Model<T> {
         let gxa0 = if !T::TRACKS_DERIVATIVES && shxa.v() == 0.0 {
             T::c(1.0) // cos(0)
         } else {
-            let b0 = bxa * shxa;
-            (cxa * (b0 - exa * (b0 - b0.atan())).atan()).cos() // 4.E52
+            weight(self.rcx1_is_1, cxa, bxa * shxa, exa) // 4.E52
         };
-        let b = bxa * a_s;
-        (cxa * (b - exa * (b - b.atan())).atan()).cos() / gxa0 // 4.E51
+        weight(self.rcx1_is_1, cxa, bxa * a_s, exa) / gxa0 // 4.E51
     }
 
     /// Overturning moment: eq. (49) of Besselink's draft MF 6.1 paper (with
@@ -595,8 +597,13 @@ impl<T: Real> Model<T> {
         let at_eq = (alphat.tan() * alphat.tan() + kk2).sqrt().atan() * sign(alphat); // A55
         let s =
             r0 * (p.ssz1 + p.ssz2 * (fy * self.inv_fnomin) + (p.ssz3 + p.ssz4 * dfz) * g_z) * p.ls; // A56
-        let mzr = dr * (cr * (br * ar_eq).atan()).cos() * c.smooth; // 4.E75
-                                                                    // Fy at γ = 0 (and Gyκ with the original γ*, as MFeval does to match TNO).
+                                                                                                    // Without turn slip Cr = 1 exactly, and cos(atan z) = 1/sqrt(1 + z²).
+        let mzr = if spin.is_none() {
+            dr * cos_atan(br * ar_eq)
+        } else {
+            dr * (cr * (br * ar_eq).atan()).cos()
+        } * c.smooth; // 4.E75
+                      // Fy at γ = 0 (and Gyκ with the original γ*, as MFeval does to match TNO).
         let f0 = if c.gamma_star == 0.0 {
             // γ* = 0: the lateral force at γ = 0 is the one just computed.
             f
@@ -635,5 +642,18 @@ impl<T: Real> Model<T> {
             mzr,
             flags: fl,
         }
+    }
+}
+
+/// The combined-slip weighting function cos(C·atan(B − E·(B − atan B)))
+/// (Pacejka eqs. 4.E51, 4.E59); with C = 1 (`unit_c`, a value-only shortcut)
+/// it is 1/sqrt(1 + y²) of the inner argument y.
+#[inline(always)]
+fn weight<T: Real>(unit_c: bool, c: T, b: T, e: T) -> T {
+    let y = b - e * (b - b.atan());
+    if unit_c {
+        cos_atan(y)
+    } else {
+        (c * y.atan()).cos()
     }
 }

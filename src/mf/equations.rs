@@ -341,7 +341,12 @@ impl<T: Real> Model<T> {
         let p = &self.p;
         let fz = T::c(c.fz);
         let dvyk = fz * (p.rvy1 + p.rvy2 * dfz + p.rvy3 * gs) * cos_atan(p.rvy4 * c.alpha_star); // 4.E67 / (μy ζ2)
-        let svyk = dvyk * (p.rvy5 * (p.rvy6 * c.kappa).atan()).sin() * p.lvyka * c.smooth; // 4.E66
+        let svyk = if !T::TRACKS_DERIVATIVES && dvyk.v() == 0.0 {
+            T::c(0.0) // value-only: no κ-induced side force
+        } else {
+            dvyk * (p.rvy5 * (p.rvy6 * c.kappa).atan()).sin() * p.lvyka * c.smooth
+            // 4.E66
+        };
         let shyk = p.rhy1 + p.rhy2 * dfz; // 4.E65
         let (eyk, hit) = cap_one(p.rey1 + p.rey2 * dfz, c.mode.limits); // 4.E64
         if hit {
@@ -523,8 +528,13 @@ impl<T: Real> Model<T> {
             * p.lky
             * self.inv_lmuy; // A58
         let ct = p.qcz1; // 4.E41
-        let et = (p.qez1 + p.qez2 * dfz + p.qez3 * dfz * dfz)
-            * ((p.qez4 + p.qez5 * gs_z) * (2.0 / PI) * (bt * ct * alphat).atan() + 1.0); // 4.E44
+        let qez45 = p.qez4 + p.qez5 * gs_z;
+        let et_shape = if !T::TRACKS_DERIVATIVES && qez45.v() == 0.0 {
+            T::c(1.0) // value-only: the atan term is multiplied by 0
+        } else {
+            qez45 * (2.0 / PI) * (bt * ct * alphat).atan() + 1.0
+        };
+        let et = (p.qez1 + p.qez2 * dfz + p.qez3 * dfz * dfz) * et_shape; // 4.E44
         let (et, hit) = cap_one(et, c.mode.limits);
         if hit {
             fl |= Clamped::ET;

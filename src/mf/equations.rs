@@ -206,7 +206,7 @@ impl<T: Real> Model<T> {
             *fl |= Clamped::EX;
         }
         let bk = bx * kx;
-        let mut fx0 = dx * (cx * (bk - ex * (bk - bk.atan())).atan()).sin() + svx; // 4.E9
+        let mut fx0 = dx * (cx * curved(bk, ex).atan()).sin() + svx; // 4.E9
         if c.vx < 0.0 {
             fx0 = -fx0;
         }
@@ -282,7 +282,7 @@ impl<T: Real> Model<T> {
                 let kyrp0 = kyg0 / (-s.eps_g + 1.0); // 4.89
                 let bhyp = kyrp0 / (chyp * dhyp * kya0_p); // 4.88
                 let x = bhyp * r0 * s.phi;
-                let shyp = dhyp * (chyp * (x - ehyp * (x - x.atan())).atan()).sin() * sign(c.vx); // 4.80
+                let shyp = dhyp * (chyp * curved(x, ehyp).atan()).sin() * sign(c.vx); // 4.80
                 (T::c(0.0), shyp + 1.0 - svyg / kya_p) // 4.83, 4.84
             }
             None => (one, one),
@@ -314,7 +314,7 @@ impl<T: Real> Model<T> {
         }
         let by = kya / (cy * dy + EPS * sign1(dy)); // 4.E26
         let ba = by * ay;
-        let mut fy0 = dy * (cy * (ba - ey * (ba - ba.atan())).atan()).sin() + svy; // 4.E19
+        let mut fy0 = dy * (cy * curved(ba, ey).atan()).sin() + svy; // 4.E19
         if c.mode.alpha_star && c.vx < 0.0 {
             fy0 = -fy0;
         }
@@ -624,11 +624,7 @@ impl<T: Real> Model<T> {
         let fy_prime = gyk * f0.fy0; // 4.E74
         let bat = bt * at_eq;
         // 4.E73, multiplied by LFZO as TNO's solver does (found by MFeval).
-        let t = dt
-            * (ct * (bat - et * (bat - bat.atan())).atan()).cos()
-            * c.cos_alpha_prime
-            * p.lfzo
-            * c.smooth;
+        let t = dt * (ct * curved(bat, et).atan()).cos() * c.cos_alpha_prime * p.lfzo * c.smooth;
         let mz = if self.is52() {
             -t * (fy - svyk0) + mzr + s * fx // MF-Tyre 5.2 manual
         } else {
@@ -660,10 +656,22 @@ impl<T: Real> Model<T> {
 /// it is 1/sqrt(1 + y²) of the inner argument y.
 #[inline(always)]
 fn weight<T: Real>(unit_c: bool, c: T, b: T, e: T) -> T {
-    let y = b - e * (b - b.atan());
+    let y = curved(b, e);
     if unit_c {
         cos_atan(y)
     } else {
         (c * y.atan()).cos()
+    }
+}
+
+/// The Magic Formula's curvature-modified argument B·x − E·(B·x − atan(B·x))
+/// (`bx` = B·x); with E = 0 exactly it is B·x (a value-only shortcut that
+/// saves the inner atan).
+#[inline(always)]
+fn curved<T: Real>(bx: T, e: T) -> T {
+    if !T::TRACKS_DERIVATIVES && e.v() == 0.0 {
+        bx
+    } else {
+        bx - e * (bx - bx.atan())
     }
 }

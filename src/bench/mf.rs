@@ -243,7 +243,27 @@ pub fn run(ctx: &BenchContext) -> crate::Result<()> {
     let ns_eval = time_ns(&inp, reps, |x| tyre.evaluate(x, mode).re);
     println!("[mf] Tyre::forces   (Fx Fy Mx My Mz, combined slip): {ns_forces:8.1} ns/eval");
     println!("[mf] Tyre::evaluate (all 30 outputs):                {ns_eval:8.1} ns/eval");
-    python_peers(ctx, &tyre, mode, &inp, ns_forces);
+    // A fully populated MF 6.1 file (every curvature factor and shift non-zero,
+    // so none of the zero-coefficient shortcuts applies), when the shared data
+    // is there; the Python peers then run on it.
+    let shared = match std::env::var_os("TYREKIT_SHARED") {
+        Some(s) => std::path::PathBuf::from(s),
+        None => std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared"),
+    };
+    let full = shared.join("data/tir/MagicFormula61_Parameters.tir");
+    let (peer_tyre, peer_inp, peer_ns) = match Tyre::from_file(&full) {
+        Ok(t61) => {
+            let inp61 = inputs(&t61, n);
+            let ns61 = time_ns(&inp61, reps, |x| sum(t61.forces(x, mode)));
+            println!("[mf] Tyre::forces, MFeval's MagicFormula61_Parameters.tir: {ns61:8.1} ns/eval (used for the peers)");
+            (t61, inp61, ns61)
+        }
+        Err(_) => {
+            println!("[mf] skipped: MagicFormula61_Parameters.tir (shared data not found); peers use the built-in tyre");
+            (tyre, inp, ns_forces)
+        }
+    };
+    python_peers(ctx, &peer_tyre, mode, &peer_inp, peer_ns);
     Ok(())
 }
 

@@ -310,3 +310,54 @@ fn clamping_is_reported() {
     let (_, c) = tyre.evaluate_checked(&input(p.fzmax * 2.0, 3.0, 1.6, 0.3), NO_LIMITS);
     assert!(c.is_empty());
 }
+
+/// Whatever the inputs (NaN, ±Inf, zero, huge), evaluation returns (no panic,
+/// no endless iteration) in every use mode, for every equation family.
+#[test]
+fn extreme_inputs_do_not_panic() {
+    let vals = [
+        f64::NAN,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        0.0,
+        -0.0,
+        1e300,
+        -1e300,
+        1e-300,
+        0.5,
+        -3.0,
+    ];
+    let mut tyres = vec![Tyre::builtin(), Tyre::new(symmetric_pac2002()).unwrap()];
+    let mut t62 = TyreParams::builtin();
+    t62.version = MfVersion::Mf62;
+    t62.p.fittyp = 62.0;
+    tyres.push(Tyre::new(t62).unwrap());
+    let modes: Vec<UseMode> = [111, 112, 121, 122, 211, 212, 221, 222]
+        .iter()
+        .map(|&c| UseMode::from_code(c).unwrap())
+        .collect();
+    let mut n = 0usize;
+    for t in &tyres {
+        for (i, &a) in vals.iter().enumerate() {
+            for &b in &vals {
+                let x = MfInput {
+                    fz: if i % 2 == 0 { a } else { 4000.0 },
+                    kappa: b,
+                    alpha: a,
+                    gamma: b * 0.01,
+                    phit: a,
+                    vx: b,
+                    p: if i % 3 == 0 { a } else { 0.0 },
+                    omega: if i % 4 == 0 { b } else { 0.0 },
+                };
+                for m in &modes {
+                    let (o, _) = t.evaluate_checked(&x, *m);
+                    let f = t.forces(&x, *m);
+                    std::hint::black_box((o, f));
+                    n += 1;
+                }
+            }
+        }
+    }
+    assert_eq!(n, 3 * 10 * 10 * 8);
+}

@@ -11,6 +11,30 @@
 //! type (`real.rs`; dual numbers give the fitter exact derivatives),
 //! `extras.rs` the radii, contact patch, stiffnesses and relaxation lengths.
 //! The numbers reproduce MFeval 4.0 (see `tests/mfeval_reference.rs`).
+//!
+//! Exact parameter derivatives (for the fitter): seed the parameters of
+//! interest as dual numbers and solve with the same conditioned inputs:
+//!
+//! ```
+//! use num_dual::{Dual64, DualNum};
+//! use tyrekit::mf::{MfInput, Model, Tyre, UseMode};
+//! let tyre = Tyre::builtin();
+//! let k = tyrekit::tir::keys::key_index("PDY1").unwrap();
+//! let p = tyre.params().p.map(|i, v| if i == k { Dual64::new(v, 1.0) } else { Dual64::from(v) });
+//! let model = Model::new(p, tyre.model().form);
+//! let x = MfInput { fz: 4000.0, alpha: 0.1, vx: 20.0, ..Default::default() };
+//! let (cond, _) = tyre.conditions(&x, UseMode::default());
+//! let s = model.solve(&cond);
+//! let fy = tyre.forces(&x, UseMode::default()).fy; // same value, f64 fast path
+//! assert!((s.fy.re - fy).abs() <= 1e-12 * fy.abs());
+//! let dfy_dpdy1 = s.fy.eps; // ∂Fy/∂PDY1
+//! assert!(dfy_dpdy1 < 0.0);
+//! ```
+//!
+//! Deliberate differences from MFeval 4.0 (the reference test handles each):
+//! the loaded radius of MF 6.2/5.2 files is the exact root of Fz62(Rl) = Fz,
+//! not a Nelder–Mead estimate (Rω at Fz = 0); with turn slip at φt = 0, ζ7 takes
+//! its limit instead of MFeval's 0/0 = NaN; an ω input of NaN means "estimate".
 
 pub mod equations;
 pub mod extras;

@@ -5,7 +5,7 @@
 //! same batches MFeval was called with.
 
 mod common;
-use common::{num, shared};
+use common::{num, reference_input, shared};
 use std::collections::BTreeMap;
 use tyrekit::mf::{MfInput, MfOutput, Tyre, UseMode};
 
@@ -41,19 +41,7 @@ fn batch_inst_kya_matches_mfeval_on_complete_sweeps() {
         {
             continue;
         }
-        let inp: Vec<MfInput> = rows
-            .iter()
-            .map(|r| MfInput {
-                fz: r[col("in_Fz")],
-                kappa: r[col("in_kappa")],
-                alpha: r[col("in_alpha")],
-                gamma: r[col("in_gamma")],
-                phit: r[col("in_phit")],
-                vx: r[col("in_Vx")],
-                p: r[col("in_P")],
-                omega: r[col("in_omega")],
-            })
-            .collect();
+        let inp: Vec<MfInput> = rows.iter().map(|r| reference_input(r, col)).collect();
         let mut out = vec![MfOutput::default(); inp.len()];
         tyre.evaluate_batch(&inp, UseMode::default(), &mut out);
         for (o, r) in out.iter().zip(rows) {

@@ -18,10 +18,10 @@
 //! Skips with a message when the shared data is absent.
 
 mod common;
-use common::{num, shared};
+use common::{num, reference_input, shared};
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
-use tyrekit::mf::{MfInput, Tyre, UseMode, OUTPUT_COLUMNS};
+use tyrekit::mf::{Tyre, UseMode, OUTPUT_COLUMNS};
 use tyrekit::tir::TyreParams;
 
 /// Parameter values as MFeval read them where that can differ from our
@@ -179,16 +179,7 @@ fn mfeval_reference() {
         // Our outputs, and the conditioned α, per row.
         let mut ours = Vec::with_capacity(t.rows.len());
         for r in &t.rows {
-            let inp = MfInput {
-                fz: r[c("in_Fz")],
-                kappa: r[c("in_kappa")],
-                alpha: r[c("in_alpha")],
-                gamma: r[c("in_gamma")],
-                phit: r[c("in_phit")],
-                vx: r[c("in_Vx")],
-                p: r[c("in_P")],
-                omega: r[c("in_omega")],
-            };
+            let inp = reference_input(r, c);
             let (cond, _) = tyre.conditions(&inp, mode);
             ours.push((tyre.evaluate(&inp, mode).to_array(), cond.alpha));
         }

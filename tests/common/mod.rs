@@ -22,3 +22,19 @@ pub fn num(s: &str) -> f64 {
         _ => s.parse().unwrap_or_else(|_| panic!("bad number {s:?}")),
     }
 }
+
+/// The 8 MFeval inputs of a reference CSV row (`col` maps a header name to
+/// its index).
+#[allow(dead_code)]
+pub fn reference_input(r: &[f64], col: impl Fn(&str) -> usize) -> tyrekit::mf::MfInput {
+    tyrekit::mf::MfInput {
+        fz: r[col("in_Fz")],
+        kappa: r[col("in_kappa")],
+        alpha: r[col("in_alpha")],
+        gamma: r[col("in_gamma")],
+        phit: r[col("in_phit")],
+        vx: r[col("in_Vx")],
+        p: r[col("in_P")],
+        omega: r[col("in_omega")],
+    }
+}

@@ -95,7 +95,6 @@ struct Fy0<T> {
     fy0: T,
     muy: T,
     kya: T,
-    kyg0: T,
     shy: T,
     svy: T,
     by: T,
@@ -325,7 +324,6 @@ impl<T: Real> Model<T> {
             fy0,
             muy,
             kya,
-            kyg0,
             shy,
             svy,
             by,
@@ -630,7 +628,6 @@ impl<T: Real> Model<T> {
         } else {
             -t * fy_prime + mzr + s * fx // 4.E71, 4.E72
         };
-        let _ = f.kyg0;
 
         let mx = self.mx(c, dpi, fy);
         let my = self.my(c, fx);

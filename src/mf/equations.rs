@@ -554,7 +554,8 @@ impl<T: Real> Model<T> {
                 }
                 let cdrp = p.qdrp1; // 4.96
                 let ddrp = mzp_inf / (cdrp * (0.5 * PI)).sin(); // 4.94
-                                                                // As in MFeval: QDZ8·QDZ9·dfz (product) and |γ| unscaled (4.99).
+
+                // As in MFeval: QDZ8·QDZ9·dfz (product) and |γ| unscaled (4.99).
                 let kzgr0 = fzm
                     * r0
                     * (p.qdz8 * p.qdz9 * dfz + (p.qdz10 + p.qdz11 * dfz * c.gamma.abs()))
@@ -562,8 +563,9 @@ impl<T: Real> Model<T> {
                 let bdrp = kzgr0 / (cdrp * ddrp * (-s.eps_g + 1.0));
                 let drp = ddrp * (cdrp * (bdrp * r0 * c.phit).atan()).sin();
                 let mzp90 = mzp_inf * (2.0 / PI) * (p.qcrp2 * r0 * c.phit.abs()).atan() * gyk; // 4.103
-                                                                                               // At φt = 0 both are 0; use the limit φt → 0 of the ratio
-                                                                                               // (MFeval gives 0/0 = NaN there: a deliberate difference).
+
+                // At φt = 0 both are 0; use the limit φt → 0 of the ratio
+                // (MFeval gives 0/0 = NaN there: a deliberate difference).
                 let ratio = if drp.v() == 0.0 && c.phit == 0.0 {
                     mzp_inf * (2.0 / PI) * p.qcrp2 * gyk / abs(ddrp * cdrp * bdrp)
                 } else {
@@ -605,7 +607,8 @@ impl<T: Real> Model<T> {
         let at_eq = (alphat.tan() * alphat.tan() + kk2).sqrt().atan() * sign(alphat); // A55
         let s =
             r0 * (p.ssz1 + p.ssz2 * (fy * self.inv_fnomin) + (p.ssz3 + p.ssz4 * dfz) * g_z) * p.ls; // A56
-                                                                                                    // Without turn slip Cr = 1 exactly, and cos(atan z) = 1/sqrt(1 + z²).
+
+        // Without turn slip Cr = 1 exactly, and cos(atan z) = 1/sqrt(1 + z²).
         let mzr = if spin.is_none() {
             dr * cos_atan(br * ar_eq)
         } else {

@@ -6,8 +6,44 @@
 //! Must never: allocate in [`Tyre::evaluate`] / [`Tyre::forces`], hold global
 //! state, or return a finite number where the equations are undefined.
 //!
-//! STUB (to be replaced by the Magic Formula work of issue #2): the API below is
-//! the contract other modules build on; the numbers are a crude placeholder.
+//! Layout: `limits.rs` conditions the inputs (range limits, low speed, α*),
+//! `equations.rs` holds the force/moment equations generic over the scalar
+//! type (`real.rs`; dual numbers give the fitter exact derivatives),
+//! `extras.rs` the radii, contact patch, stiffnesses and relaxation lengths.
+//! The numbers reproduce MFeval 4.0 (see `tests/mfeval_reference.rs`).
+//!
+//! Exact parameter derivatives (for the fitter): seed the parameters of
+//! interest as dual numbers and solve with the same conditioned inputs:
+//!
+//! ```
+//! use num_dual::{Dual64, DualNum};
+//! use tyrekit::mf::{MfInput, Model, Tyre, UseMode};
+//! let tyre = Tyre::builtin();
+//! let k = tyrekit::tir::keys::key_index("PDY1").unwrap();
+//! let p = tyre.params().p.map(|i, v| if i == k { Dual64::new(v, 1.0) } else { Dual64::from(v) });
+//! let model = Model::new(p, tyre.model().form);
+//! let x = MfInput { fz: 4000.0, alpha: 0.1, vx: 20.0, ..Default::default() };
+//! let (cond, _) = tyre.conditions(&x, UseMode::default());
+//! let s = model.solve(&cond);
+//! let fy = tyre.forces(&x, UseMode::default()).fy; // same value, f64 fast path
+//! assert!((s.fy.re - fy).abs() <= 1e-12 * fy.abs());
+//! let dfy_dpdy1 = s.fy.eps; // ∂Fy/∂PDY1
+//! assert!(dfy_dpdy1 < 0.0);
+//! ```
+//!
+//! Deliberate differences from MFeval 4.0 (the reference test handles each):
+//! the loaded radius of MF 6.2/5.2 files is the exact root of Fz62(Rl) = Fz,
+//! not a Nelder–Mead estimate (Rω at Fz = 0); with turn slip at φt = 0, ζ7 takes
+//! its limit instead of MFeval's 0/0 = NaN; an ω input of NaN means "estimate".
+
+pub mod equations;
+pub mod extras;
+pub mod limits;
+pub mod real;
+
+pub use equations::{Form, Model, Solution};
+pub use limits::{Clamped, Conditions};
+pub use real::Real;
 
 use crate::tir::{MfVersion, TyreParams};
 
@@ -172,12 +208,37 @@ impl MfOutput {
 #[derive(Clone, Debug)]
 pub struct Tyre {
     params: TyreParams,
+    model: Model<f64>,
+}
+
+/// The equation family for a file version.
+pub fn form_of(version: MfVersion) -> Form {
+    match version {
+        MfVersion::Mf61 | MfVersion::Mf62 => Form::Mf6,
+        MfVersion::Mf52 => Form::Mf52,
+        MfVersion::Pac2002 => Form::Pac2002,
+    }
 }
 
 impl Tyre {
     /// Prepare a tyre from loaded parameters.
     pub fn new(params: TyreParams) -> crate::Result<Tyre> {
-        Ok(Tyre { params })
+        let p = &params.p;
+        for (name, v) in [
+            ("FNOMIN", p.fnomin),
+            ("UNLOADED_RADIUS", p.unloaded_radius),
+            ("NOMPRES", p.nompres),
+            ("LONGVL", p.longvl),
+        ] {
+            if !v.is_finite() {
+                return Err(crate::Error::Other(format!(
+                    "{}: {name} = {v} is not a finite number",
+                    params.source
+                )));
+            }
+        }
+        let model = Model::new(params.p.clone(), form_of(params.version));
+        Ok(Tyre { params, model })
     }
     /// Load a `.tir` file and prepare it.
     pub fn from_file(path: &std::path::Path) -> crate::Result<Tyre> {
@@ -185,9 +246,9 @@ impl Tyre {
     }
     /// The built-in default tyre.
     pub fn builtin() -> Tyre {
-        Tyre {
-            params: TyreParams::builtin(),
-        }
+        let params = TyreParams::builtin();
+        let model = Model::new(params.p.clone(), form_of(params.version));
+        Tyre { params, model }
     }
     /// The parameters this tyre was built from.
     pub fn params(&self) -> &TyreParams {
@@ -197,52 +258,117 @@ impl Tyre {
     pub fn version(&self) -> MfVersion {
         self.params.version
     }
+    /// The prepared equations (`f64`). For derivatives, build a
+    /// `Model<Dual…>` from `params().p.map(…)` and call [`Model::solve`] with
+    /// the same [`Conditions`] (see [`Tyre::conditions`]).
+    pub fn model(&self) -> &Model<f64> {
+        &self.model
+    }
 
-    /// Full evaluation (all 30 outputs). Allocation-free.
-    pub fn evaluate(&self, inp: &MfInput, mode: UseMode) -> MfOutput {
-        let _ = mode;
-        let p = &self.params.p;
-        let fz = inp.fz.max(0.0);
-        let dfz = (fz - p.fnomin) / p.fnomin;
-        let mux = p.pdx1 + p.pdx2 * dfz;
-        let muy = p.pdy1 + p.pdy2 * dfz;
-        let kx = fz * (p.pkx1 + p.pkx2 * dfz);
-        let ky = p.pky1 * p.fnomin * (2.0 * (fz / (p.pky2 * p.fnomin)).atan()).sin();
-        let fx = mux * fz * (p.pcx1 * (kx / (p.pcx1 * mux * fz + 1e-9) * inp.kappa).atan()).sin();
-        let fy = muy * fz * (p.pcy1 * (ky / (p.pcy1 * muy * fz + 1e-9) * inp.alpha).atan()).sin();
-        MfOutput {
-            fx,
-            fy,
-            fz,
-            kappa: inp.kappa,
-            alpha: inp.alpha,
-            gamma: inp.gamma,
-            vx: inp.vx,
-            mux,
-            muy,
-            kya: ky,
-            kxk: kx,
-            re: p.unloaded_radius,
-            ..Default::default()
+    /// Conditioned inputs for one evaluation (with ω estimated when turn slip
+    /// needs it and none is given), and what the limits clamped.
+    pub fn conditions(&self, inp: &MfInput, mode: UseMode) -> (Conditions, Clamped) {
+        let (mut c, cl) = Conditions::new(&self.params.p, inp, mode);
+        if mode.turn_slip && !(inp.omega != 0.0 && inp.omega.is_finite()) {
+            c.omega = extras::effective_radius(&self.params.p, &c, 0.0).2;
         }
+        (c, cl)
+    }
+
+    /// Full evaluation (all 30 outputs). Allocation-free. `inst_kya` is 0 for
+    /// a single evaluation (it is a finite difference along a batch, see
+    /// [`Tyre::evaluate_batch`]).
+    pub fn evaluate(&self, inp: &MfInput, mode: UseMode) -> MfOutput {
+        self.evaluate_checked(inp, mode).0
+    }
+
+    /// [`Tyre::evaluate`] plus the report of which limits acted.
+    pub fn evaluate_checked(&self, inp: &MfInput, mode: UseMode) -> (MfOutput, Clamped) {
+        let p = &self.params.p;
+        let (mut c, cl) = Conditions::new(p, inp, mode);
+        let given = if inp.omega.is_nan() { 0.0 } else { inp.omega };
+        // ω: given, or estimated from the Re iteration; then Re, Rω from it.
+        let omega_used = if given != 0.0 {
+            given
+        } else {
+            extras::effective_radius(p, &c, 0.0).2
+        };
+        c.omega = omega_used;
+        let (re, romega, omega) = extras::effective_radius(p, &c, omega_used);
+        let s = self.model.solve(&c);
+        let is52 = self.model.form != Form::Mf6;
+        let is61 = self.params.version == MfVersion::Mf61;
+        let (rl, rho, cz) = extras::loaded_radius(p, is61, &c, omega, romega, s.fx, s.fy);
+        let (a, b) = extras::contact_patch(p, is52, &c);
+        let (cx, cy, sigmax, sigmay) = extras::relaxation(p, is52, &c, s.kxk, s.kya);
+        let muy = if mode.limits { s.muy.abs() } else { s.muy };
+        let out = MfOutput {
+            fx: s.fx,
+            fy: s.fy,
+            fz: c.fz_u,
+            mx: s.mx,
+            my: s.my,
+            mz: s.mz,
+            kappa: c.kappa_low,
+            alpha: c.alpha_out,
+            gamma: c.gamma_u,
+            phit: c.phit,
+            vx: c.vx,
+            p: c.p,
+            re,
+            rho,
+            a2: 2.0 * a,
+            t: s.t,
+            mux: s.mux,
+            muy,
+            omega,
+            rl,
+            b2: 2.0 * b,
+            mzr: s.mzr,
+            cx,
+            cy,
+            cz,
+            kya: s.kya,
+            sigmax,
+            sigmay,
+            inst_kya: 0.0,
+            kxk: s.kxk,
+        };
+        (out, Clamped(cl.0 | s.flags))
     }
 
     /// Forces and moments only: the hot path. Allocation-free.
+    #[inline]
     pub fn forces(&self, inp: &MfInput, mode: UseMode) -> Forces {
-        let o = self.evaluate(inp, mode);
+        let (c, _) = self.conditions(inp, mode);
+        let s = self.model.solve(&c);
         Forces {
-            fx: o.fx,
-            fy: o.fy,
-            mx: o.mx,
-            my: o.my,
-            mz: o.mz,
+            fx: s.fx,
+            fy: s.fy,
+            mx: s.mx,
+            my: s.my,
+            mz: s.mz,
         }
     }
 
-    /// Batch evaluation over slices (`out.len()` must equal `inp.len()`).
+    /// Batch evaluation over slices (`out.len()` must equal `inp.len()`;
+    /// extra elements of either are ignored). `inst_kya` is MFeval's finite
+    /// difference ΔFy/Δα between consecutive rows (with the conditioned α),
+    /// the last row repeating the previous value; 0 for a single row.
     pub fn evaluate_batch(&self, inp: &[MfInput], mode: UseMode, out: &mut [MfOutput]) {
+        let n = inp.len().min(out.len());
         for (i, o) in inp.iter().zip(out.iter_mut()) {
             *o = self.evaluate(i, mode);
+        }
+        if n > 1 {
+            let alpha = |i: usize| Conditions::new(&self.params.p, &inp[i], mode).0.alpha;
+            let mut a0 = alpha(0);
+            for i in 0..n - 1 {
+                let a1 = alpha(i + 1);
+                out[i].inst_kya = (out[i + 1].fy - out[i].fy) / (a1 - a0);
+                a0 = a1;
+            }
+            out[n - 1].inst_kya = out[n - 2].inst_kya;
         }
     }
 }

@@ -82,14 +82,28 @@ macro_rules! tir_keys {
         /// The struct is `#[repr(C)]` and holds only `f64`, so it can also be
         /// viewed as a slice indexed like [`KEYS`] ([`MfParams::as_slice`]),
         /// which is what the fitter uses.
+        ///
+        /// The scalar type is generic so that the Magic Formula equations can
+        /// run on forward-mode dual numbers (exact parameter derivatives for
+        /// the fitter); everything else uses the default `MfParams<f64>`.
         #[repr(C)]
         #[derive(Clone, Debug, PartialEq)]
         #[allow(missing_docs)]
-        pub struct MfParams {
-            $( $( pub $field: f64, )* )*
+        pub struct MfParams<T = f64> {
+            $( $( pub $field: T, )* )*
         }
 
-        impl Default for MfParams {
+        impl<T: Copy> MfParams<T> {
+            /// Convert every value with `f(index in KEYS, value)`, e.g. to
+            /// dual numbers whose derivative part seeds selected parameters.
+            #[allow(unused_assignments)]
+            pub fn map<U>(&self, mut f: impl FnMut(usize, T) -> U) -> MfParams<U> {
+                let mut i = 0usize;
+                MfParams { $( $( $field: { let v = f(i, self.$field); i += 1; v }, )* )* }
+            }
+        }
+
+        impl Default for MfParams<f64> {
             /// Every key at its default value.
             fn default() -> Self {
                 MfParams { $( $( $field: $default, )* )* }
@@ -404,9 +418,9 @@ tir_keys! {
     qdrp2 "QDRP2" One 0.0;
 }
 
-const _: () = assert!(std::mem::size_of::<MfParams>() == N_KEYS * std::mem::size_of::<f64>());
+const _: () = assert!(std::mem::size_of::<MfParams<f64>>() == N_KEYS * std::mem::size_of::<f64>());
 
-impl MfParams {
+impl MfParams<f64> {
     /// The parameters as a slice indexed like [`KEYS`].
     pub fn as_slice(&self) -> &[f64] {
         // SAFETY: `MfParams` is `#[repr(C)]` and consists of exactly `N_KEYS`

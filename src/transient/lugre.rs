@@ -31,14 +31,25 @@
 //! slip LuGre behaves as the relaxation model with σ = K/C), σ1_i = c_i/Fz
 //! (the low-speed damping of the relaxation model), σ2 = 0, κ_L = 0.
 //!
-//! θ depends only on the inputs, so over a step with held inputs the bristle
-//! equations are linear with constant coefficients and are solved exactly.
+//! Low speed (below VXLOW, blended with the same weight w as the relaxation
+//! damping): the elasto-plastic form of Dupont, Hayward, Armstrong & Altpeter
+//! ("Single state elastoplastic friction models", IEEE TAC 47(5), 2002)
+//! multiplies the bristle-rate term by a(z) = 1 − w·(1 − α(z)), α = 0 while
+//! |z| < β·z_ss or while the bristle unloads (sgn z ≠ sgn vr), rising smoothly
+//! to 1 at z_ss. Without it LuGre drifts under an oscillating load (a parked
+//! car rocking on its tyres creeps downhill); with it, presliding is purely
+//! elastic. In steady state |z| = z_ss, α = 1, so the steady forces are unchanged.
+//!
+//! From VXLOW up θ depends only on the inputs, so over a step with held inputs
+//! the bristle equations are linear with constant coefficients and are solved
+//! exactly. Below VXLOW a(z) is frozen over sub-steps short enough that z
+//! moves by at most 5 % of z_ss per sub-step (at most 32, deterministic).
 //!
 //! Parameters may come from a `[LUGRE]` section of the `.tir`
 //! ([`LuGreParams::from_tir_text`], [`LuGreParams::to_tir_section`]); keys
 //! (SI): `SIGMA0X`, `SIGMA0Y` (1/m), `SIGMA1X`, `SIGMA1Y` (s/m), `SIGMA2` (s/m),
 //! `MUC`, `MUS` (–), `VS` (m/s), `DELTA` (–, Stribeck exponent), `KAPPA_L`
-//! (1/m). A zero SIGMA* means "derive the default". `MUC` > 0 selects the
+//! (1/m), `BREAKAWAY` (–). A zero SIGMA* means "derive the default". `MUC` > 0 selects the
 //! Stribeck friction function; otherwise `MUS` is the ratio μs/μc applied to
 //! the Magic Formula curve.
 //!
@@ -79,6 +90,8 @@ pub struct LuGreParams {
     pub delta: f64,
     /// Average-lumped distributed-bristle coefficient κ_L (1/m).
     pub kappa_l: f64,
+    /// Breakaway ratio β = z_ba/z_ss of the elasto-plastic low-speed form (–, 0..1).
+    pub breakaway: f64,
 }
 
 impl Default for LuGreParams {
@@ -97,13 +110,24 @@ impl Default for LuGreParams {
             vs: 3.5,
             delta: 1.0,
             kappa_l: 0.0,
+            breakaway: 0.5,
         }
     }
 }
 
 /// Names of the `[LUGRE]` keys, in writer order.
-pub const LUGRE_KEYS: [&str; 10] = [
-    "SIGMA0X", "SIGMA0Y", "SIGMA1X", "SIGMA1Y", "SIGMA2", "MUC", "MUS", "VS", "DELTA", "KAPPA_L",
+pub const LUGRE_KEYS: [&str; 11] = [
+    "SIGMA0X",
+    "SIGMA0Y",
+    "SIGMA1X",
+    "SIGMA1Y",
+    "SIGMA2",
+    "MUC",
+    "MUS",
+    "VS",
+    "DELTA",
+    "KAPPA_L",
+    "BREAKAWAY",
 ];
 
 impl LuGreParams {
@@ -136,7 +160,8 @@ impl LuGreParams {
                 "MUS" => p.mu_s = x,
                 "VS" => p.vs = x,
                 "DELTA" => p.delta = x,
-                _ => p.kappa_l = x,
+                "KAPPA_L" => p.kappa_l = x,
+                _ => p.breakaway = x.min(0.99),
             }
         }
         if p.mu_c > 0.0 {
@@ -219,6 +244,7 @@ impl LuGreParams {
             self.vs,
             self.delta,
             self.kappa_l,
+            self.breakaway,
         ];
         let mut s = String::from("[LUGRE]\n");
         for (k, v) in LUGRE_KEYS.iter().zip(vals) {
@@ -236,6 +262,24 @@ fn stribeck_shape(v: f64, p: &LuGreParams) -> f64 {
         (-r).exp()
     } else {
         (-r.powf(p.delta)).exp()
+    }
+}
+
+/// Elasto-plastic factor α(z) of Dupont et al. 2002: 0 below the breakaway
+/// β·z_ss and while unloading, 1 at and above z_ss, a half sine in between.
+#[inline]
+fn elastoplastic(z: f64, zss: f64, vr: f64, beta: f64) -> f64 {
+    if z * vr <= 0.0 || !(zss > 0.0) {
+        return if zss > 0.0 { 0.0 } else { 1.0 };
+    }
+    let r = z.abs() / zss;
+    if r >= 1.0 {
+        1.0
+    } else if r <= beta {
+        0.0
+    } else {
+        let x = (r - 0.5 * (1.0 + beta)) / (1.0 - beta);
+        0.5 + 0.5 * (std::f64::consts::PI * x).sin()
     }
 }
 
@@ -273,12 +317,36 @@ pub(crate) fn step(c: &StepCtx, p: &LuGreParams, st: &mut TransientState, dt: f6
             (s0x * vr / g + transport, s0y * vr / g + transport)
         }
     };
-    let zx = relax_exact(st.x[SLOT_X], thx, vrx, dt);
-    let zy = relax_exact(st.x[SLOT_Y], thy, vry, dt);
+    // z_ss per direction (for the elasto-plastic factor): g_i/σ0_i.
+    let (zssx, zssy) = (
+        (vrx / (thx - transport)).abs(),
+        (vry / (thy - transport)).abs(),
+    );
+    let w = c.props.weight;
+    let (mut zx, mut zy) = (st.x[SLOT_X], st.x[SLOT_Y]);
+    let (mut thx_e, mut thy_e) = (thx, thy);
+    if w > 0.0 {
+        let rate = |th: f64, z: f64, zss: f64, vr: f64| {
+            let a = 1.0 - w * (1.0 - elastoplastic(z, zss, vr, p.breakaway));
+            (th - transport) * a + transport
+        };
+        let lim = 0.05 * zssx.min(zssy).max(1e-9);
+        let n = ((vr * dt / lim).ceil() as usize).clamp(1, 32);
+        let h = dt / n as f64;
+        for _ in 0..n {
+            thx_e = rate(thx, zx, zssx, vrx);
+            thy_e = rate(thy, zy, zssy, vry);
+            zx = relax_exact(zx, thx_e, vrx, h);
+            zy = relax_exact(zy, thy_e, vry, h);
+        }
+    } else {
+        zx = relax_exact(zx, thx, vrx, dt);
+        zy = relax_exact(zy, thy, vry, dt);
+    }
     st.x[SLOT_X] = zx;
     st.x[SLOT_Y] = zy;
-    let dzx = vrx - thx * zx;
-    let dzy = vry - thy * zy;
+    let dzx = vrx - thx_e * zx;
+    let dzy = vry - thy_e * zy;
     let fx = fz * (s0x * zx + s1x * dzx + p.sigma2 * vrx);
     let fy = fz * (s0y * zy + s1y * dzy + p.sigma2 * vry);
     // Aligning moment: the MF's, scaled by the ratio of dynamic to steady Fy

@@ -193,9 +193,9 @@ pub const SIGMA_MAX: f64 = 10.0;
 /// local slope vanishes or turns negative).
 pub const NL_SIGMA_MIN_FRACTION: f64 = 0.05;
 /// Non-linear variant: the largest change of κ' or tan α' per sub-step.
-pub const NL_MAX_SLIP_CHANGE: f64 = 0.02;
+pub const NL_MAX_SLIP_CHANGE: f64 = 0.01;
 /// Non-linear variant: the most sub-steps in one step.
-pub const NL_MAX_SUBSTEPS: usize = 16;
+pub const NL_MAX_SUBSTEPS: usize = 32;
 /// Normal load (N) below which the tyre is off the ground: no force, state at rest.
 pub const FZ_OFF: f64 = 1e-3;
 
@@ -213,6 +213,8 @@ pub struct Kinematics {
     pub kappa: f64,
     /// tan α = Vsy/|Vx| (|Vx| floored at [`V_EPS`]).
     pub tan_alpha: f64,
+    /// Rolling speed of the contact |Vx − Vsx| (= |Ω·Re| from velocities) (m/s).
+    pub v_roll: f64,
 }
 
 /// Slip from the wheel's motion (Pacejka, *Tyre and Vehicle Dynamics*, 3rd ed.,
@@ -231,6 +233,7 @@ pub fn kinematics(mode: InputMode, inp: &WheelInput, re: f64) -> Kinematics {
                 vsy,
                 kappa: -vsx / v,
                 tan_alpha: vsy / v,
+                v_roll: (inp.vx - vsx).abs(),
             }
         }
         InputMode::Slips => {
@@ -241,6 +244,7 @@ pub fn kinematics(mode: InputMode, inp: &WheelInput, re: f64) -> Kinematics {
                 vsy: tan_alpha * vx_abs,
                 kappa: inp.kappa_in,
                 tan_alpha,
+                v_roll: (inp.vx + inp.kappa_in * vx_abs).abs(),
             }
         }
     }
@@ -279,6 +283,12 @@ pub struct TyreProps {
     /// speed blend (zero above VXLOW).
     pub damp_x: f64,
     pub damp_y: f64,
+    /// Low-speed blend w(|Vx|) (1 at rest, 0 from VXLOW up).
+    pub weight: f64,
+    /// Deflections friction can hold, μ·Fz/C (m), longitudinal / lateral
+    /// (infinite when the MF gives no μ); before the friction scale.
+    pub ux_max: f64,
+    pub uy_max: f64,
     /// Unweighted damping coefficients (N s/m) (LuGre σ1 default).
     pub damp_x_full: f64,
     pub damp_y_full: f64,
@@ -366,12 +376,23 @@ pub fn tyre_props(tyre: &Tyre, o: &MfOutput, fz: f64, vx_abs: f64) -> TyreProps 
     let damp_x_full = nn(p.damp_vlow) * cx + 2.0 * nn(p.damp_long) * (cx * mb).sqrt();
     let damp_y_full = nn(p.damp_vlow) * cy + 2.0 * nn(p.damp_lat) * (cy * mb).sqrt();
     let w = low_speed_weight(vx_abs, p.vxlow);
+    let hold = |mu: f64, c: f64| {
+        let u = mu.abs() * fz / c;
+        if u.is_finite() && u > 0.0 {
+            u
+        } else {
+            f64::INFINITY
+        }
+    };
     TyreProps {
         re: pos(o.re, r0),
         cx,
         cy,
         sigma_x,
         sigma_y,
+        weight: w,
+        ux_max: hold(o.mux, cx),
+        uy_max: hold(o.muy, cy),
         damp_x: w * damp_x_full,
         damp_y: w * damp_y_full,
         damp_x_full,
@@ -603,24 +624,59 @@ impl TransientModel {
     }
 }
 
+/// Speed at which the contact deflections decay (the rate of rolled
+/// distance): |Vx| (Pacejka's form) from VXLOW up, blended below VXLOW into
+/// the rolling speed of the contact |Vx − Vsx| = |Ω·Re| (brush/stretched-string
+/// theory: the tread is renewed by rolling). The two agree for a free-rolling
+/// wheel; for a wheel that neither rolls nor slides (a parked car rocking on
+/// its tyres, a locked wheel at rest) the rolling speed is 0, so the elastic
+/// deflection cannot creep away however the body oscillates.
+#[inline]
+fn decay_speed(c: &StepCtx) -> f64 {
+    let w = c.props.weight;
+    (1.0 - w) * c.kin.vx_abs + w * c.kin.v_roll
+}
+
+/// Low-speed saturation of the deflections: below VXLOW a deflection beyond
+/// what friction can hold (μ·Fz/C, times the friction scale) is not elastic
+/// but sliding, so it is dropped: |u| ≤ u_max/w (no limit from VXLOW up,
+/// where the slip model itself saturates the force). Without it, a wheel
+/// that locks and stops keeps the deflection σκ·|κ'| ≈ σκ of full sliding
+/// (tens of cm) and pushes the vehicle back by as much once at rest.
+#[inline]
+fn saturate(c: &StepCtx, u: f64, w: f64) -> (f64, f64) {
+    let k = c.props.weight;
+    if k <= 0.0 {
+        return (u, w);
+    }
+    let lx = c.s * c.props.ux_max / k;
+    let ly = c.s * c.props.uy_max / k;
+    (u.clamp(-lx, lx), w.clamp(-ly, ly))
+}
+
 /// Linear relaxation in deflection form (Pacejka 3rd ed. §7.2.1, eqs 7.9–7.12,
 /// with the MF-Tyre low-speed damping of §7.2.3):
 ///
 /// ```text
-///   du/dt = −Vsx − |Vx|·u/σκ        κ'     = (u + τx·w·du/dt)/σκ
-///   dv/dt =  Vsy − |Vx|·v/σα        tan α' = (v + τy·w·dv/dt)/σα
-///   dφ'/dt = (|Vx|/σα)·(φt − φ')    (turn slip, when used)
+///   du/dt = −Vsx − V·u/σκ        κ'     = (u + τx·w·du/dt)/σκ
+///   dv/dt =  Vsy − V·v/σα        tan α' = (v + τy·w·dv/dt)/σα
+///   dφ'/dt = (V/σα)·(φt − φ')    (turn slip, when used)
 /// ```
+/// with V = |Vx| from VXLOW up ([`decay_speed`] below), and the low-speed
+/// saturation of [`saturate`].
 /// τ = c/C (damping over carcass stiffness), w the low-speed blend. At rest
 /// (|Vx| = 0) the deflection integrates the slip speed: the force is the
-/// carcass spring C·u (+ damping), with no creep (the decay term is ∝ |Vx|).
+/// carcass spring C·u (+ damping), with no creep (the decay term is ∝ the rolling speed).
 /// Returns the slips (κ', tan α') the Magic Formula is evaluated at.
 fn relax_linear(c: &StepCtx, st: &mut TransientState, dt: f64) -> (f64, f64) {
     let (sx, sy) = (c.props.sigma_x, c.props.sigma_y);
-    let v = c.kin.vx_abs;
+    let v = decay_speed(c);
     let (rx, ry) = (v / sx, v / sy);
-    let u = relax_exact(st.x[SLOT_X], rx, -c.kin.vsx, dt);
-    let w = relax_exact(st.x[SLOT_Y], ry, c.kin.vsy, dt);
+    let (u, w) = saturate(
+        c,
+        relax_exact(st.x[SLOT_X], rx, -c.kin.vsx, dt),
+        relax_exact(st.x[SLOT_Y], ry, c.kin.vsy, dt),
+    );
     st.x[SLOT_X] = u;
     st.x[SLOT_Y] = w;
     if c.mode.turn_slip {
@@ -673,15 +729,25 @@ fn inst_sigma(c: &StepCtx, k: f64, t: f64) -> (f64, f64) {
 /// relaxation length σ(κ') = C_Fκ(κ')/C from the local slope. With the state
 /// scaled as in the linear model (κ' = u/σκ0):
 /// `du/dt = (σκ0/σκ(κ'))·(−Vsx − |Vx|·u/σκ0)`, likewise laterally. σ is frozen
-/// over each sub-step (solved exactly); the number of sub-steps keeps the
+/// over each sub-step at its exponential-midpoint value (solved exactly, second
+/// order in the sub-step); the number of sub-steps keeps the
 /// change of κ' and tan α' per sub-step below [`NL_MAX_SLIP_CHANGE`].
 fn relax_nonlinear(c: &StepCtx, st: &mut TransientState, dt: f64) -> (f64, f64) {
     let (s0x, s0y) = (c.props.sigma_x, c.props.sigma_y);
-    let v = c.kin.vx_abs;
+    let v = decay_speed(c);
+    // One sub-step: σ at the exponential-midpoint state (predicted with σ at
+    // the start), then an exact step with that σ: second order in the sub-step.
     let sub = |u: f64, w: f64, h: f64| {
+        let adv = |u: f64, w: f64, sx: f64, sy: f64, h: f64| {
+            (
+                relax_exact(u, v / sx, -c.kin.vsx * s0x / sx, h),
+                relax_exact(w, v / sy, c.kin.vsy * s0y / sy, h),
+            )
+        };
         let (sx, sy) = inst_sigma(c, u / s0x, w / s0y);
-        let u1 = relax_exact(u, v / sx, -c.kin.vsx * s0x / sx, h);
-        let w1 = relax_exact(w, v / sy, c.kin.vsy * s0y / sy, h);
+        let (um, wm) = adv(u, w, sx, sy, 0.5 * h);
+        let (sx, sy) = inst_sigma(c, um / s0x, wm / s0y);
+        let (u1, w1) = adv(u, w, sx, sy, h);
         (u1, w1, sx, sy)
     };
     let (u0, w0) = (st.x[SLOT_X], st.x[SLOT_Y]);
@@ -695,6 +761,7 @@ fn relax_nonlinear(c: &StepCtx, st: &mut TransientState, dt: f64) -> (f64, f64) 
             (u, w, sx, sy) = sub(u, w, h);
         }
     }
+    (u, w) = saturate(c, u, w);
     st.x[SLOT_X] = u;
     st.x[SLOT_Y] = w;
     if c.mode.turn_slip {

@@ -83,8 +83,12 @@ pub struct BrakingResult {
     pub textbook_distance: f64,
     /// Mean longitudinal slip while braking above 3 m/s after the build-up.
     pub mean_slip: f64,
-    /// Largest |speed| after stopping, until `t_max` or 2 s later (m/s): the standstill hold.
-    pub residual_speed: f64,
+    /// Largest distance from the stopping point during the 2 s after stopping
+    /// (m): the tyre's elastic spring-back (and any roll-away).
+    pub rebound: f64,
+    /// Mean position relative to the stopping point over the second of those
+    /// 2 s (m): where the vehicle comes to rest on its tyre spring.
+    pub rest_offset: f64,
 }
 
 impl BrakingScenario {
@@ -109,6 +113,7 @@ impl BrakingScenario {
         let mut res = BrakingResult::default();
         let (mut slip_sum, mut slip_n) = (0.0, 0usize);
         let mut t_stop = f64::INFINITY;
+        let (mut off_sum, mut off_n) = (0.0, 0usize);
         let n_steps = (self.t_max / self.dt).ceil() as usize;
         for _ in 0..n_steps {
             let inp = WheelInput {
@@ -162,7 +167,12 @@ impl BrakingScenario {
                 t_stop = t;
             }
             if res.stopped {
-                res.residual_speed = res.residual_speed.max(v.abs());
+                let d = x - res.stopping_distance;
+                res.rebound = res.rebound.max(d.abs());
+                if t > t_stop + 1.0 {
+                    off_sum += d;
+                    off_n += 1;
+                }
                 if t > t_stop + 2.0 {
                     break;
                 }
@@ -172,6 +182,11 @@ impl BrakingScenario {
             res.stopping_distance = x;
             res.stopping_time = t;
         }
+        res.rest_offset = if off_n > 0 {
+            off_sum / off_n as f64
+        } else {
+            0.0
+        };
         res.mean_slip = if slip_n > 0 {
             slip_sum / slip_n as f64
         } else {

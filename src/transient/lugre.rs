@@ -55,7 +55,7 @@
 //!
 //! Must never: allocate in [`step`], divide by a speed or a force without a guard.
 
-use super::{mf_at, relax_exact, StepCtx, TransientState, WheelOutput, SLOT_X, SLOT_Y};
+use super::{mf_at, relax_exact, Slip, StepCtx, TransientState, WheelOutput, SLOT_X, SLOT_Y};
 
 /// Which friction function the bristles saturate at.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -288,7 +288,7 @@ pub(crate) fn step(c: &StepCtx, p: &LuGreParams, st: &mut TransientState, dt: f6
     let fz = c.fz;
     let vrx = -c.kin.vsx;
     let vry = -c.kin.vsy;
-    let vr = vrx.hypot(vry);
+    let vr = (vrx * vrx + vry * vry).sqrt();
     let pos = |x: f64, fb: f64| if x > 0.0 { x } else { fb };
     let s0x = pos(p.sigma0x, c.props.cx / fz);
     let s0y = pos(p.sigma0y, c.props.cy / fz);
@@ -296,7 +296,7 @@ pub(crate) fn step(c: &StepCtx, p: &LuGreParams, st: &mut TransientState, dt: f6
     let s1y = pos(p.sigma1y, c.props.damp_y_full / fz);
     let transport = p.kappa_l * c.omega_re.abs();
     // Steady MF at the kinematic slips (also the moments and μ outputs).
-    let o = mf_at(c.tyre, &c.base, c.mode, c.kin.kappa, c.kin.tan_alpha, c.s);
+    let o = mf_at(c.tyre, &c.base, c.mode, Slip::of(&c.kin), c.s);
     let (thx, thy) = match p.friction {
         LuGreFriction::MagicFormula => {
             let strib = if p.mu_s != 1.0 {
@@ -364,10 +364,10 @@ pub(crate) fn step(c: &StepCtx, p: &LuGreParams, st: &mut TransientState, dt: f6
         my: o.my,
         mz,
         kappa: c.kin.kappa,
-        alpha: c.kin.tan_alpha.atan(),
+        alpha: c.kin.alpha,
         re: c.props.re,
-        mux: o.mux,
-        muy: o.muy,
+        mux: c.s * c.props.mux,
+        muy: c.s * c.props.muy,
         vsx: c.kin.vsx,
         vsy: c.kin.vsy,
         sigma_x: c.props.sigma_x,

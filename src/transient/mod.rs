@@ -34,7 +34,7 @@ pub mod scenario;
 
 pub use lugre::{LuGreFriction, LuGreParams};
 
-use crate::mf::{MfInput, MfOutput, Tyre, UseMode};
+use crate::mf::{Forces, MfInput, MfOutput, Tyre, UseMode};
 use crate::tir::MfVersion;
 
 /// Which dynamics sit between the wheel's motion and the Magic Formula.
@@ -215,6 +215,8 @@ pub struct Kinematics {
     pub tan_alpha: f64,
     /// Rolling speed of the contact |Vx − Vsx| (= |Ω·Re| from velocities) (m/s).
     pub v_roll: f64,
+    /// α = atan(tan α) (rad); exactly `alpha_in` for prescribed slips.
+    pub alpha: f64,
 }
 
 /// Slip from the wheel's motion (Pacejka, *Tyre and Vehicle Dynamics*, 3rd ed.,
@@ -234,6 +236,7 @@ pub fn kinematics(mode: InputMode, inp: &WheelInput, re: f64) -> Kinematics {
                 kappa: -vsx / v,
                 tan_alpha: vsy / v,
                 v_roll: (inp.vx - vsx).abs(),
+                alpha: (vsy / v).atan(),
             }
         }
         InputMode::Slips => {
@@ -245,26 +248,28 @@ pub fn kinematics(mode: InputMode, inp: &WheelInput, re: f64) -> Kinematics {
                 kappa: inp.kappa_in,
                 tan_alpha,
                 v_roll: (inp.vx + inp.kappa_in * vx_abs).abs(),
+                alpha: inp.alpha_in,
             }
         }
     }
 }
 
-/// φ₁(z) = (1 − e^{−z})/z, with φ₁(0) = 1; exact for all z ≥ 0.
-#[inline]
-pub fn phi1(z: f64) -> f64 {
-    if z < 1e-8 {
-        1.0 - 0.5 * z
-    } else {
-        -(-z).exp_m1() / z
-    }
-}
-
-/// Exact solution of `ẋ = d − r·x` (r ≥ 0, d constant) after `h` seconds.
+/// Exact solution of `ẋ = d − r·x` (r ≥ 0, d constant) after `h` seconds:
+/// `x·e^{−z} + d·h·φ₁(z)`, z = r·h, with one exponential (Taylor series
+/// below z = 1e-3, where they are exact to round-off).
 #[inline]
 pub fn relax_exact(x: f64, r: f64, d: f64, h: f64) -> f64 {
     let z = r * h;
-    x * (-z).exp() + d * h * phi1(z)
+    let (e, p1) = if z < 1e-3 {
+        (
+            1.0 - z * (1.0 - z * (0.5 - z * (1.0 / 6.0 - z / 24.0))),
+            1.0 - z * (0.5 - z * (1.0 / 6.0 - z * (1.0 / 24.0 - z / 120.0))),
+        )
+    } else {
+        let e = (-z).exp();
+        (e, (1.0 - e) / z)
+    };
+    x * e + d * h * p1
 }
 
 /// Per-step tyre properties, from one Magic Formula evaluation at zero slip
@@ -292,6 +297,9 @@ pub struct TyreProps {
     /// Unweighted damping coefficients (N s/m) (LuGre σ1 default).
     pub damp_x_full: f64,
     pub damp_y_full: f64,
+    /// Friction coefficients (MF's μx, μy; slip-independent), before the friction scale.
+    pub mux: f64,
+    pub muy: f64,
     /// Slip stiffnesses at zero slip, Kxκ (N) and Kyα (N/rad), from the MF.
     pub kxk: f64,
     pub kya: f64,
@@ -397,12 +405,16 @@ pub fn tyre_props(tyre: &Tyre, o: &MfOutput, fz: f64, vx_abs: f64) -> TyreProps 
         damp_y: w * damp_y_full,
         damp_x_full,
         damp_y_full,
+        mux: o.mux,
+        muy: o.muy,
         kxk: o.kxk,
         kya: o.kya,
     }
 }
 
-/// Magic Formula at slips (κ, tan α) on a road of friction scale `s`.
+/// Magic Formula forces at slips (κ, tan α) on a road of friction scale `s`
+/// (the hot-path [`Tyre::forces`]; the slip-independent outputs come from the
+/// probe, see [`tyre_props`]).
 ///
 /// `mu_scale` is applied by the similarity method (Pacejka 3rd ed. §4.3.2;
 /// Radt & Pacejka): a friction change by `s` that leaves the slip stiffness
@@ -413,32 +425,50 @@ pub fn tyre_props(tyre: &Tyre, o: &MfOutput, fz: f64, vx_abs: f64) -> TyreProps 
 /// A native `mu_scale` in `MfInput` (scaling LMUX/LMUY inside the MF) would
 /// make this exact — see the transient report.
 #[inline]
-pub fn mf_at(
-    tyre: &Tyre,
-    base: &MfInput,
-    mode: UseMode,
-    kappa: f64,
-    tan_alpha: f64,
-    s: f64,
-) -> MfOutput {
+pub fn mf_at(tyre: &Tyre, base: &MfInput, mode: UseMode, slip: Slip, s: f64) -> Forces {
     let mut mi = *base;
     if s == 1.0 {
-        mi.kappa = kappa;
-        mi.alpha = tan_alpha.atan();
-        tyre.evaluate(&mi, mode)
+        mi.kappa = slip.kappa;
+        mi.alpha = slip.alpha;
+        tyre.forces(&mi, mode)
     } else {
-        mi.kappa = kappa / s;
-        mi.alpha = (tan_alpha / s).atan();
-        let mut o = tyre.evaluate(&mi, mode);
+        mi.kappa = slip.kappa / s;
+        mi.alpha = (slip.tan_alpha / s).atan();
+        let mut o = tyre.forces(&mi, mode);
         o.fx *= s;
         o.fy *= s;
         o.mx *= s;
         o.mz *= s;
-        o.mux *= s;
-        o.muy *= s;
-        o.kappa = kappa;
-        o.alpha = tan_alpha.atan();
         o
+    }
+}
+
+/// A slip point: κ, tan α and α (kept together so α = atan(tan α) is computed once).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Slip {
+    pub kappa: f64,
+    pub tan_alpha: f64,
+    pub alpha: f64,
+}
+
+impl Slip {
+    /// From κ and tan α.
+    #[inline]
+    pub fn new(kappa: f64, tan_alpha: f64) -> Slip {
+        Slip {
+            kappa,
+            tan_alpha,
+            alpha: tan_alpha.atan(),
+        }
+    }
+    /// The kinematic slips of a step.
+    #[inline]
+    pub fn of(k: &Kinematics) -> Slip {
+        Slip {
+            kappa: k.kappa,
+            tan_alpha: k.tan_alpha,
+            alpha: k.alpha,
+        }
     }
 }
 
@@ -532,8 +562,8 @@ impl TransientModel {
     /// Advance by `dt` seconds with inputs held constant over the step and
     /// return the outputs at the end of the step. On error the state is unchanged.
     ///
-    /// Cost: two Magic Formula evaluations (a zero-slip probe for Re, the
-    /// stiffnesses and relaxation lengths, and the force evaluation); the
+    /// Cost: one full Magic Formula evaluation (a zero-slip probe for Re, μ,
+    /// the stiffnesses and relaxation lengths) and one forces-only one; the
     /// non-linear relaxation variant adds three per sub-step for the local slope.
     pub fn step(&mut self, tyre: &Tyre, inp: &WheelInput, dt: f64) -> crate::Result<WheelOutput> {
         let s = validate(self.config.input_mode, inp, dt)?;
@@ -566,13 +596,13 @@ impl TransientModel {
         let out = if fz <= FZ_OFF {
             // Off the ground: no force, the tyre springs back to rest.
             next = TransientState::default();
-            let o = mf_at(tyre, &base, mode, kin.kappa, kin.tan_alpha, s);
-            self.output(&ctx, &o, kin.kappa, kin.tan_alpha)
+            let sl = Slip::of(&kin);
+            self.output(&ctx, &mf_at(tyre, &base, mode, sl, s), sl)
         } else {
             match self.config.kind {
                 TransientKind::Steady => {
-                    let o = mf_at(tyre, &base, mode, kin.kappa, kin.tan_alpha, s);
-                    self.output(&ctx, &o, kin.kappa, kin.tan_alpha)
+                    let sl = Slip::of(&kin);
+                    self.output(&ctx, &mf_at(tyre, &base, mode, sl, s), sl)
                 }
                 TransientKind::Relaxation => {
                     let (k, t) = if self.options.nonlinear {
@@ -584,8 +614,8 @@ impl TransientModel {
                     if mode.turn_slip {
                         b.phit = next.x[SLOT_PHI];
                     }
-                    let o = mf_at(tyre, &b, mode, k, t, s);
-                    self.output(&ctx, &o, k, t)
+                    let sl = Slip::new(k, t);
+                    self.output(&ctx, &mf_at(tyre, &b, mode, sl, s), sl)
                 }
                 TransientKind::LuGre => lugre::step(&ctx, &self.options.lugre, &mut next, dt),
             }
@@ -604,18 +634,18 @@ impl TransientModel {
         Ok(out)
     }
 
-    fn output(&self, c: &StepCtx, o: &MfOutput, kappa: f64, tan_alpha: f64) -> WheelOutput {
+    fn output(&self, c: &StepCtx, o: &Forces, sl: Slip) -> WheelOutput {
         WheelOutput {
             fx: o.fx,
             fy: o.fy,
             mx: o.mx,
             my: o.my,
             mz: o.mz,
-            kappa,
-            alpha: tan_alpha.atan(),
+            kappa: sl.kappa,
+            alpha: sl.alpha,
             re: c.props.re,
-            mux: o.mux,
-            muy: o.muy,
+            mux: c.s * c.props.mux,
+            muy: c.s * c.props.muy,
             vsx: c.kin.vsx,
             vsy: c.kin.vsy,
             sigma_x: c.props.sigma_x,
@@ -698,7 +728,7 @@ fn inst_sigma(c: &StepCtx, k: f64, t: f64) -> (f64, f64) {
     const H: f64 = 1e-5;
     let mut mi = c.base;
     let f = |mi: &mut MfInput, kk: f64, tt: f64| {
-        let o = mf_at(c.tyre, mi, c.mode, kk, tt, c.s);
+        let o = mf_at(c.tyre, mi, c.mode, Slip::new(kk, tt), c.s);
         (o.fx, o.fy)
     };
     let f0 = f(&mut mi, k, t);

@@ -269,8 +269,14 @@ fn stribeck_shape(v: f64, p: &LuGreParams) -> f64 {
 /// β·z_ss and while unloading, 1 at and above z_ss, a half sine in between.
 #[inline]
 fn elastoplastic(z: f64, zss: f64, vr: f64, beta: f64) -> f64 {
-    if z * vr <= 0.0 || !(zss > 0.0) {
-        return if zss > 0.0 { 0.0 } else { 1.0 };
+    let valid = zss.is_finite() && zss > 0.0;
+    if !valid {
+        // No steady bristle deflection to compare with (no sliding): plain LuGre.
+        return 1.0;
+    }
+    if z * vr <= 0.0 {
+        // Unloading (or at rest): elastic.
+        return 0.0;
     }
     let r = z.abs() / zss;
     if r >= 1.0 {

@@ -344,3 +344,46 @@ fn bounded_over_speed_and_step_range() {
         }
     }
 }
+
+/// Reversing mirrors driving forwards: braking while reversing (Vx = −10 m/s,
+/// Ω·Re = −9 m/s) gives the opposite Fx of braking forwards (Vx = 10,
+/// Ω·Re = 9), and the same |Fy| opposing the lateral slip, to 1e-9 relative
+/// (the transient models use κ = −Vsx/|Vx| and a forward-rolling MF).
+#[test]
+fn reversing_mirrors_forward() {
+    let tyre = Tyre::builtin();
+    let r = re(&tyre, 10.0);
+    for kind in [TransientKind::Relaxation, TransientKind::LuGre] {
+        let mut fw = model(kind, InputMode::Velocities);
+        let mut bw = model(kind, InputMode::Velocities);
+        let (mut a, mut b) = Default::default();
+        for _ in 0..500 {
+            a = fw.step(&tyre, &vel(10.0, 0.3, 9.0 / r), 1e-3).unwrap();
+            b = bw.step(&tyre, &vel(-10.0, 0.3, -9.0 / r), 1e-3).unwrap();
+        }
+        let (a, b): (
+            tyrekit::transient::WheelOutput,
+            tyrekit::transient::WheelOutput,
+        ) = (a, b);
+        assert!(
+            a.fx < 0.0,
+            "{}: braking forwards gives Fx {}",
+            kind.name(),
+            a.fx
+        );
+        assert!(
+            (a.fx + b.fx).abs() <= 1e-9 * a.fx.abs(),
+            "{}: {} vs {}",
+            kind.name(),
+            a.fx,
+            b.fx
+        );
+        assert!(
+            (a.fy - b.fy).abs() <= 1e-9 * a.fy.abs(),
+            "{}: {} vs {}",
+            kind.name(),
+            a.fy,
+            b.fy
+        );
+    }
+}

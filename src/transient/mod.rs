@@ -582,10 +582,26 @@ impl TransientModel {
         let probe = tyre.evaluate(&base, mode);
         let props = tyre_props(tyre, &probe, fz, inp.vx.abs());
         let kin = kinematics(self.config.input_mode, inp, props.re);
+        let steady = self.config.kind == TransientKind::Steady;
+        // The force evaluation. Transient models: forward speed ≥ VXLOW, so
+        // that the MF's steady-state low-speed slip reduction and its
+        // backward-speed sign flip stay out (the transient model handles low
+        // speed and direction itself, with κ = −Vsx/|Vx| — as MFeval's
+        // transient modes skip that reduction). Steady: the MF as it is.
+        let fbase = if steady {
+            base
+        } else {
+            let vl = tyre.params().p.vxlow;
+            let vl = if vl.is_finite() && vl > 0.0 { vl } else { 1.0 };
+            MfInput {
+                vx: inp.vx.abs().max(vl),
+                ..base
+            }
+        };
         let ctx = StepCtx {
             tyre,
             mode,
-            base,
+            base: fbase,
             kin,
             props,
             s,
@@ -593,33 +609,41 @@ impl TransientModel {
             omega_re: inp.omega * props.re,
         };
         let mut next = self.state;
-        let out = if fz <= FZ_OFF {
-            // Off the ground: no force, the tyre springs back to rest.
-            next = TransientState::default();
-            let sl = Slip::of(&kin);
-            self.output(&ctx, &mf_at(tyre, &base, mode, sl, s), sl)
+        let mut out = if fz <= FZ_OFF || steady {
+            if fz <= FZ_OFF {
+                // Off the ground: no force, the tyre springs back to rest.
+                next = TransientState::default();
+            }
+            // MF convention for the steady model: κ = −Vsx/Vx with the sign
+            // of Vx (MFeval flips Fx for Vx < 0 itself).
+            let mut sl = Slip::of(&kin);
+            if self.config.input_mode == InputMode::Velocities && inp.vx < 0.0 {
+                sl.kappa = -sl.kappa;
+            }
+            self.output(&ctx, &mf_at(tyre, &fbase, mode, sl, s), sl)
         } else {
             match self.config.kind {
-                TransientKind::Steady => {
-                    let sl = Slip::of(&kin);
-                    self.output(&ctx, &mf_at(tyre, &base, mode, sl, s), sl)
-                }
                 TransientKind::Relaxation => {
                     let (k, t) = if self.options.nonlinear {
                         relax_nonlinear(&ctx, &mut next, dt)
                     } else {
                         relax_linear(&ctx, &mut next, dt)
                     };
-                    let mut b = base;
+                    let mut b = fbase;
                     if mode.turn_slip {
                         b.phit = next.x[SLOT_PHI];
                     }
                     let sl = Slip::new(k, t);
                     self.output(&ctx, &mf_at(tyre, &b, mode, sl, s), sl)
                 }
-                TransientKind::LuGre => lugre::step(&ctx, &self.options.lugre, &mut next, dt),
+                _ => lugre::step(&ctx, &self.options.lugre, &mut next, dt),
             }
         };
+        if !steady {
+            // Rolling resistance at the actual speed and direction (the MF's
+            // own low-speed treatment), from the zero-slip probe.
+            out.my = probe.my;
+        }
         let all_finite = next.x.iter().all(|x| x.is_finite())
             && out.fx.is_finite()
             && out.fy.is_finite()

@@ -53,7 +53,7 @@
 //! Stribeck friction function; otherwise `MUS` is the ratio μs/μc applied to
 //! the Magic Formula curve.
 //!
-//! Must never: allocate in [`step`], divide by a speed or a force without a guard.
+//! Must never: allocate in `step`, divide by a speed or a force without a guard.
 
 use super::{mf_at, relax_exact, Slip, StepCtx, TransientState, WheelOutput, SLOT_X, SLOT_Y};
 

@@ -387,3 +387,36 @@ fn reversing_mirrors_forward() {
         );
     }
 }
+
+/// A wheel off the ground (Fz ≤ 0): no force or moment, the state returns to
+/// rest, and landing again starts from rest (the first step equals a fresh model's).
+#[test]
+fn off_the_ground_no_force_and_state_at_rest() {
+    let tyre = Tyre::builtin();
+    for kind in [
+        TransientKind::Steady,
+        TransientKind::Relaxation,
+        TransientKind::LuGre,
+    ] {
+        let mut m = model(kind, InputMode::Velocities);
+        for _ in 0..100 {
+            m.step(&tyre, &vel(20.0, 1.0, 70.0), 1e-3).unwrap();
+        }
+        for fz in [0.0, -500.0] {
+            let mut inp = vel(20.0, 1.0, 70.0);
+            inp.fz = fz;
+            let out = m.step(&tyre, &inp, 1e-3).unwrap();
+            assert_eq!(
+                (out.fx, out.fy, out.mx, out.my, out.mz),
+                (0.0, 0.0, 0.0, 0.0, 0.0),
+                "{} fz {fz}",
+                kind.name()
+            );
+            assert!(m.state.x.iter().all(|x| *x == 0.0));
+        }
+        let mut fresh = model(kind, InputMode::Velocities);
+        let a = m.step(&tyre, &vel(20.0, 1.0, 70.0), 1e-3).unwrap();
+        let b = fresh.step(&tyre, &vel(20.0, 1.0, 70.0), 1e-3).unwrap();
+        assert_eq!(a, b);
+    }
+}

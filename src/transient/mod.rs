@@ -629,11 +629,24 @@ impl TransientModel {
             omega_re: inp.omega * props.re,
         };
         let mut next = self.state;
-        let mut out = if fz <= FZ_OFF || steady {
-            if fz <= FZ_OFF {
-                // Off the ground: no force, the tyre springs back to rest.
-                next = TransientState::default();
+        let mut out = if fz <= FZ_OFF {
+            // Off the ground: no force (whatever the MF makes of Fz = 0), the
+            // tyre springs back to rest.
+            next = TransientState::default();
+            let fin = |x: f64| if x.is_finite() { x } else { 0.0 };
+            WheelOutput {
+                kappa: kin.kappa,
+                alpha: kin.alpha,
+                re: props.re,
+                mux: fin(s * props.mux),
+                muy: fin(s * props.muy),
+                vsx: kin.vsx,
+                vsy: kin.vsy,
+                sigma_x: props.sigma_x,
+                sigma_y: props.sigma_y,
+                ..Default::default()
             }
+        } else if steady {
             // MF convention for the steady model: κ = −Vsx/Vx with the sign
             // of Vx (MFeval flips Fx for Vx < 0 itself).
             let mut sl = Slip::of(&kin);
@@ -659,7 +672,7 @@ impl TransientModel {
                 _ => lugre::step(&ctx, &self.options.lugre, &mut next, dt),
             }
         };
-        if !steady {
+        if !steady && fz > FZ_OFF {
             // Rolling resistance at the actual speed and direction (the MF's
             // own low-speed treatment), from the zero-slip probe.
             out.my = probe.my;
@@ -667,6 +680,8 @@ impl TransientModel {
         let all_finite = next.x.iter().all(|x| x.is_finite())
             && out.fx.is_finite()
             && out.fy.is_finite()
+            && out.mx.is_finite()
+            && out.my.is_finite()
             && out.mz.is_finite();
         if !all_finite {
             return Err(crate::Error::Numeric(format!(

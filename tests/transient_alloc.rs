@@ -8,7 +8,7 @@ use common::*;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use tyrekit::mf::Tyre;
-use tyrekit::transient::{InputMode, TransientKind, TransientOptions};
+use tyrekit::transient::{InputMode, TransientOptions};
 
 struct Counting;
 static ALLOCS: AtomicUsize = AtomicUsize::new(0);
@@ -30,11 +30,7 @@ static GLOBAL: Counting = Counting;
 fn step_does_not_allocate() {
     let tyre = Tyre::builtin();
     let mut models = Vec::new();
-    for kind in [
-        TransientKind::Steady,
-        TransientKind::Relaxation,
-        TransientKind::LuGre,
-    ] {
+    for kind in KINDS {
         for mode in [InputMode::Velocities, InputMode::Slips] {
             for nonlinear in [false, true] {
                 let o = TransientOptions {

@@ -155,11 +155,7 @@ fn real_tir_files_never_crash() {
             4000.0
         };
         let r0 = tyre.params().p.unloaded_radius.max(0.1);
-        for kind in [
-            TransientKind::Steady,
-            TransientKind::Relaxation,
-            TransientKind::LuGre,
-        ] {
+        for kind in KINDS {
             for nonlinear in [false, true] {
                 for dt in [1e-3, 1e-2] {
                     let o = TransientOptions {

@@ -252,10 +252,7 @@ fn mu_scale_scales_friction_not_stiffness() {
 fn reset_clears_state() {
     let tyre = Tyre::builtin();
     for kind in [TransientKind::Relaxation, TransientKind::LuGre] {
-        let mut m = model(kind, InputMode::Velocities);
-        for _ in 0..200 {
-            m.step(&tyre, &vel(10.0, 0.5, 36.0), 1e-3).unwrap();
-        }
+        let mut m = driven(&tyre, kind, 200, vel(10.0, 0.5, 36.0));
         assert!(m.state.x.iter().any(|x| *x != 0.0));
         m.reset();
         assert!(m.state.x.iter().all(|x| *x == 0.0));
@@ -270,15 +267,8 @@ fn reset_clears_state() {
 #[test]
 fn refused_steps_leave_state_unchanged() {
     let tyre = Tyre::builtin();
-    for kind in [
-        TransientKind::Steady,
-        TransientKind::Relaxation,
-        TransientKind::LuGre,
-    ] {
-        let mut m = model(kind, InputMode::Velocities);
-        for _ in 0..50 {
-            m.step(&tyre, &vel(10.0, 0.5, 36.0), 1e-3).unwrap();
-        }
+    for kind in KINDS {
+        let mut m = driven(&tyre, kind, 50, vel(10.0, 0.5, 36.0));
         let before = m.state;
         let good = vel(10.0, 0.5, 36.0);
         let mut bad = [good; 6];
@@ -315,11 +305,7 @@ fn refused_steps_leave_state_unchanged() {
 fn bounded_over_speed_and_step_range() {
     let tyre = Tyre::builtin();
     let bound = 3.0 * FZ * tyre.params().p.pdx1.abs().max(tyre.params().p.pdy1.abs());
-    for kind in [
-        TransientKind::Steady,
-        TransientKind::Relaxation,
-        TransientKind::LuGre,
-    ] {
+    for kind in KINDS {
         for nl in [false, true] {
             for dt in [1e-5, 1e-3, 1e-2] {
                 for vx in [0.0, 0.01, 1.0, 30.0, 83.3] {
@@ -393,15 +379,8 @@ fn reversing_mirrors_forward() {
 #[test]
 fn off_the_ground_no_force_and_state_at_rest() {
     let tyre = Tyre::builtin();
-    for kind in [
-        TransientKind::Steady,
-        TransientKind::Relaxation,
-        TransientKind::LuGre,
-    ] {
-        let mut m = model(kind, InputMode::Velocities);
-        for _ in 0..100 {
-            m.step(&tyre, &vel(20.0, 1.0, 70.0), 1e-3).unwrap();
-        }
+    for kind in KINDS {
+        let mut m = driven(&tyre, kind, 100, vel(20.0, 1.0, 70.0));
         for fz in [0.0, -500.0] {
             let mut inp = vel(20.0, 1.0, 70.0);
             inp.fz = fz;

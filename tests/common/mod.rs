@@ -8,6 +8,22 @@ use tyrekit::transient::{
 };
 
 pub const G: f64 = 9.81;
+
+/// Every transient model kind.
+pub const KINDS: [TransientKind; 3] = [
+    TransientKind::Steady,
+    TransientKind::Relaxation,
+    TransientKind::LuGre,
+];
+
+/// A velocity-input model of `kind` driven `n` steps of 1 ms with `inp`.
+pub fn driven(tyre: &Tyre, kind: TransientKind, n: usize, inp: WheelInput) -> TransientModel {
+    let mut m = model(kind, InputMode::Velocities);
+    for _ in 0..n {
+        m.step(tyre, &inp, 1e-3).expect("driving step");
+    }
+    m
+}
 pub const FZ: f64 = 4000.0;
 
 pub fn model(kind: TransientKind, mode: InputMode) -> TransientModel {

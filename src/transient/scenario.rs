@@ -135,11 +135,15 @@ impl BrakingScenario {
                 BrakeControl::Locked => available,
                 BrakeControl::SlipControl { target, min_speed } => {
                     if v > min_speed {
-                        // Wheel torque balance plus a proportional correction whose
-                        // time constant Iw/(Re·k) is 20 ms at every speed.
+                        // Wheel torque balance (the torque that keeps the slip
+                        // constant while the vehicle decelerates at Fx/m) plus a
+                        // proportional correction whose time constant Iw/(Re·k)
+                        // is 20 ms at every speed.
                         let k = 1.0 / (re * 0.02) * self.wheel_inertia;
                         let s = (v - omega * re) / v;
-                        (-out.fx * re + k * v * (target - s)).clamp(0.0, available)
+                        let spin_down =
+                            -self.wheel_inertia * (1.0 - target) * out.fx / (self.mass * re);
+                        (-out.fx * re + spin_down + k * v * (target - s)).clamp(0.0, available)
                     } else {
                         available
                     }

@@ -399,3 +399,47 @@ fn off_the_ground_no_force_and_state_at_rest() {
         assert_eq!(a, b);
     }
 }
+
+/// At constant slip the relaxation models settle exactly on the MF of that
+/// slip (the MF is evaluated on the lagged slips, which converge to the
+/// kinematic ones): from velocities, over κ ∈ [−1, 1] and α ∈ [−15°, 15°],
+/// linear and non-linear, within 1e-6 of the MF force (+1e-6·Fz).
+#[test]
+fn relaxation_steady_state_is_the_magic_formula() {
+    let tyre = Tyre::builtin();
+    let v = 25.0;
+    let r = re(&tyre, v);
+    for nonlinear in [false, true] {
+        for (k, a) in [
+            (0.0, 0.0),
+            (0.05, 0.0),
+            (-0.3, 0.0),
+            (1.0, 0.0),
+            (-1.0, 0.0),
+            (0.0, 0.05),
+            (0.0, -0.26),
+            (0.1, 0.1),
+            (-0.5, -0.2),
+        ] {
+            let o = TransientOptions {
+                nonlinear,
+                ..Default::default()
+            };
+            let mut m = model_opts(TransientKind::Relaxation, InputMode::Velocities, o);
+            // κ = −Vsx/|Vx| = (Ω·Re − Vx)/Vx, tan α = Vy/Vx.
+            let inp = vel(v, v * (a as f64).tan(), v * (1.0 + k) / r);
+            let mut out = Default::default();
+            for _ in 0..3000 {
+                out = m.step(&tyre, &inp, 1e-3).unwrap();
+            }
+            let out: tyrekit::transient::WheelOutput = out;
+            let mfo = mf(&tyre, v, k, a);
+            for (got, want, n) in [(out.fx, mfo.fx, "Fx"), (out.fy, mfo.fy, "Fy")] {
+                assert!(
+                    (got - want).abs() <= 1e-6 * (want.abs() + FZ),
+                    "nl {nonlinear} κ {k} α {a}: {n} {got} vs MF {want}"
+                );
+            }
+        }
+    }
+}

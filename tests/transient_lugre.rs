@@ -38,6 +38,55 @@ fn steady_state_equals_magic_formula() {
     }
 }
 
+/// With force at zero slip (SVx/SHx shifts, camber thrust): the steady state
+/// still equals the MF within 1 % (+0.1 % Fz), including near zero slip, where
+/// the offset force is carried directly and only the slip-generated part by
+/// the bristles. Shifts and camber: PVX1 = 0.03, PHY1 = 0.004, PVY1 = 0.02, γ = 3°.
+#[test]
+fn steady_state_equals_magic_formula_with_offsets() {
+    use tyrekit::mf::{MfInput, UseMode};
+    let mut params = tyrekit::tir::TyreParams::builtin();
+    params.p.pvx1 = 0.03;
+    params.p.phy1 = 0.004;
+    params.p.pvy1 = 0.02;
+    let tyre = Tyre::new(params).unwrap();
+    let (v, gamma) = (15.0, 3f64.to_radians());
+    for (k, a) in [
+        (0.0, 0.0),
+        (0.002, 0.0),
+        (-0.01, 0.0),
+        (0.0, 0.003),
+        (0.0, -0.02),
+        (0.2, 0.1),
+    ] {
+        let mut m = model(TransientKind::LuGre, InputMode::Slips);
+        let mut inp = slips(v, k, a);
+        inp.gamma = gamma;
+        let mut out = Default::default();
+        for _ in 0..2000 {
+            out = m.step(&tyre, &inp, 1e-3).unwrap();
+        }
+        let out: tyrekit::transient::WheelOutput = out;
+        let o = tyre.evaluate(
+            &MfInput {
+                fz: FZ,
+                kappa: k,
+                alpha: a,
+                gamma,
+                vx: v,
+                ..Default::default()
+            },
+            UseMode::default(),
+        );
+        for (got, want, n) in [(out.fx, o.fx, "Fx"), (out.fy, o.fy, "Fy")] {
+            assert!(
+                (got - want).abs() <= 0.01 * want.abs() + 1e-3 * FZ,
+                "κ {k} α {a}: {n} {got} vs MF {want}"
+            );
+        }
+    }
+}
+
 /// Oscillating slip (κ = 0.05 ± 0.04 at 10 Hz, 10 m/s): Fx against κ is a loop,
 /// not a line: at the mean slip the rising and falling branches differ by
 /// more than 10 % of the force swing, and the loop encloses an area.

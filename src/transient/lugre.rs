@@ -18,12 +18,17 @@
 //! * [`LuGreFriction::MagicFormula`] (default): g is derived from the Magic
 //!   Formula curve of the same tyre, per direction, so that the steady state
 //!   (ż = 0: F_i = Fz·σ0_i·vr_i/θ_i) equals the MF force at the same
-//!   (combined) slips: θ_i = Fz·σ0_i·|vr_i|/|F_i,MF(κ, α)|·1/S(‖vr‖), where the
-//!   Stribeck factor S = 1 + (μs/μc − 1)·exp(−(‖vr‖/vs)^δ) is 1 by default.
-//!   Combined-slip coupling is that of the MF (its combined-slip weights).
-//!   Wherever the MF force and vr have opposite signs (inside the small offset
-//!   band of SH/SV shifts or camber thrust), the steady force has the MF's
-//!   magnitude and the sign of vr.
+//!   (combined) slips. The MF's force at zero slip F_i,0 (shifts SH/SV,
+//!   camber thrust, from the zero-slip probe at the actual speed) is carried
+//!   directly, F_i = F_i,0 + Fz·(σ0_i·z_i + …), and the bristles carry the
+//!   slip-generated part ΔF_i = F_i,MF(κ, α) − F_i,0, which has the sign of
+//!   vr_i for any MF curve through the origin of ΔF:
+//!   θ_i = Fz·σ0_i·|vr_i|/(|ΔF_i|·S(‖vr‖)), where the Stribeck factor
+//!   S = 1 + (μs/μc − 1)·exp(−(‖vr‖/vs)^δ) is 1 by default. Steady state:
+//!   F_i = F_i,0 + ΔF_i = F_i,MF exactly. Combined-slip coupling is that of the
+//!   MF (its combined-slip weights). Should ΔF_i and vr_i ever have opposite
+//!   signs (below VXLOW, where the MF reduces its shifts), the steady force
+//!   has |ΔF_i| with the sign of vr_i.
 //! * [`LuGreFriction::Stribeck`]: the classical isotropic Stribeck curve
 //!   g(‖vr‖) = μc + (μs − μc)·exp(−(‖vr‖/vs)^δ) with θ_i = σ0_i‖vr‖/g + κ_L|ΩRe|.
 //!
@@ -303,6 +308,11 @@ pub(crate) fn step(c: &StepCtx, p: &LuGreParams, st: &mut TransientState, dt: f6
     let transport = p.kappa_l * c.omega_re.abs();
     // Steady MF at the kinematic slips (also the moments and μ outputs).
     let o = mf_at(c.tyre, &c.base, c.mode, Slip::of(&c.kin), c.s);
+    // Force at zero slip (MF mode only): carried directly, not by the bristles.
+    let (f0x, f0y) = match p.friction {
+        LuGreFriction::MagicFormula => (c.s * c.props.fx0, c.s * c.props.fy0),
+        LuGreFriction::Stribeck => (0.0, 0.0),
+    };
     let (thx, thy) = match p.friction {
         LuGreFriction::MagicFormula => {
             let strib = if p.mu_s != 1.0 {
@@ -310,12 +320,12 @@ pub(crate) fn step(c: &StepCtx, p: &LuGreParams, st: &mut TransientState, dt: f6
             } else {
                 1.0
             };
-            // θ = Fz·σ0·|vr_i| / (|F_i|·S); F floored at 1e-9·Fz (θ then just
-            // very large: z follows vr/θ ≈ 0, i.e. no force, as the MF says).
+            // θ = Fz·σ0·|vr_i| / (|ΔF_i|·S); ΔF floored at 1e-9·Fz (θ then
+            // just very large: z follows vr/θ ≈ 0, i.e. no slip force, as the MF says).
             let th = |s0: f64, v: f64, f: f64| {
                 fz * s0 * v.abs() / (f.abs() * strib).max(1e-9 * fz) + transport
             };
-            (th(s0x, vrx, o.fx), th(s0y, vry, o.fy))
+            (th(s0x, vrx, o.fx - f0x), th(s0y, vry, o.fy - f0y))
         }
         LuGreFriction::Stribeck => {
             let g = (p.mu_c + (p.mu_s - p.mu_c) * stribeck_shape(vr, p)) * c.s;
@@ -353,8 +363,8 @@ pub(crate) fn step(c: &StepCtx, p: &LuGreParams, st: &mut TransientState, dt: f6
     st.x[SLOT_Y] = zy;
     let dzx = vrx - thx_e * zx;
     let dzy = vry - thy_e * zy;
-    let fx = fz * (s0x * zx + s1x * dzx + p.sigma2 * vrx);
-    let fy = fz * (s0y * zy + s1y * dzy + p.sigma2 * vry);
+    let fx = f0x + fz * (s0x * zx + s1x * dzx + p.sigma2 * vrx);
+    let fy = f0y + fz * (s0y * zy + s1y * dzy + p.sigma2 * vry);
     // Aligning moment: the MF's, scaled by the ratio of dynamic to steady Fy
     // (the pneumatic trail of the steady state; bounded to stay sane when
     // the steady Fy is near zero).

@@ -320,6 +320,9 @@ pub struct TyreProps {
     /// Friction coefficients (MF's μx, μy; slip-independent), before the friction scale.
     pub mux: f64,
     pub muy: f64,
+    /// MF forces at zero slip (N), at the actual speed (0 if not finite).
+    pub fx0: f64,
+    pub fy0: f64,
     /// Slip stiffnesses at zero slip, Kxκ (N) and Kyα (N/rad), from the MF.
     pub kxk: f64,
     pub kya: f64,
@@ -427,6 +430,8 @@ pub fn tyre_props(tyre: &Tyre, o: &MfOutput, fz: f64, vx_abs: f64) -> TyreProps 
         damp_y_full,
         mux: o.mux,
         muy: o.muy,
+        fx0: if o.fx.is_finite() { o.fx } else { 0.0 },
+        fy0: if o.fy.is_finite() { o.fy } else { 0.0 },
         kxk: o.kxk,
         kya: o.kya,
     }

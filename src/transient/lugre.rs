@@ -26,9 +26,9 @@
 //!   θ_i = Fz·σ0_i·|vr_i|/(|ΔF_i|·S(‖vr‖)), where the Stribeck factor
 //!   S = 1 + (μs/μc − 1)·exp(−(‖vr‖/vs)^δ) is 1 by default. Steady state:
 //!   F_i = F_i,0 + ΔF_i = F_i,MF exactly. Combined-slip coupling is that of the
-//!   MF (its combined-slip weights). Should ΔF_i and vr_i ever have opposite
-//!   signs (below VXLOW, where the MF reduces its shifts), the steady force
-//!   has |ΔF_i| with the sign of vr_i.
+//!   MF (its combined-slip weights). Below VXLOW, where the MF evaluation runs
+//!   at a raised speed, ΔF is taken against that evaluation's own zero-slip
+//!   force, while F_i,0 keeps the MF's low-speed reduction of its shifts.
 //! * [`LuGreFriction::Stribeck`]: the classical isotropic Stribeck curve
 //!   g(‖vr‖) = μc + (μs − μc)·exp(−(‖vr‖/vs)^δ) with θ_i = σ0_i‖vr‖/g + κ_L|ΩRe|.
 //!
@@ -309,9 +309,15 @@ pub(crate) fn step(c: &StepCtx, p: &LuGreParams, st: &mut TransientState, dt: f6
     // Steady MF at the kinematic slips (also the moments and μ outputs).
     let o = mf_at(c.tyre, &c.base, c.mode, Slip::of(&c.kin), c.s);
     // Force at zero slip (MF mode only): carried directly, not by the bristles.
-    let (f0x, f0y) = match p.friction {
-        LuGreFriction::MagicFormula => (c.s * c.props.fx0, c.s * c.props.fy0),
-        LuGreFriction::Stribeck => (0.0, 0.0),
+    // ΔF is taken against the zero-slip force of the same (raised-speed)
+    // evaluation, so it is zero at zero slip at every speed.
+    let (f0x, f0y, b0x, b0y) = match p.friction {
+        LuGreFriction::MagicFormula => {
+            let (f0x, f0y) = (c.s * c.props.fx0, c.s * c.props.fy0);
+            let (cx, cy) = c.offset_correction();
+            (f0x, f0y, f0x - cx, f0y - cy)
+        }
+        LuGreFriction::Stribeck => (0.0, 0.0, 0.0, 0.0),
     };
     let (thx, thy) = match p.friction {
         LuGreFriction::MagicFormula => {
@@ -325,7 +331,7 @@ pub(crate) fn step(c: &StepCtx, p: &LuGreParams, st: &mut TransientState, dt: f6
             let th = |s0: f64, v: f64, f: f64| {
                 fz * s0 * v.abs() / (f.abs() * strib).max(1e-9 * fz) + transport
             };
-            (th(s0x, vrx, o.fx - f0x), th(s0y, vry, o.fy - f0y))
+            (th(s0x, vrx, o.fx - b0x), th(s0y, vry, o.fy - b0y))
         }
         LuGreFriction::Stribeck => {
             let g = (p.mu_c + (p.mu_s - p.mu_c) * stribeck_shape(vr, p)) * c.s;

@@ -34,6 +34,9 @@
 //!    do low speed and direction themselves (MFeval's steady low-speed slip
 //!    reduction would remove the standstill hold). `Steady` calls the MF as is
 //!    (κ with the sign of Vx, as MFeval expects for reversing).
+//! 3. Below VXLOW only: the forces at zero slip at the raised speed, so that
+//!    the MF's force at zero slip (shifts, camber thrust) keeps the MF's own
+//!    low-speed reduction (`StepCtx::offset_correction`).
 //!
 //! `mu_scale` is applied by the similarity method ([`mf_at`]) until the MF
 //! takes a friction scale itself.
@@ -558,6 +561,32 @@ pub(crate) struct StepCtx<'a> {
     pub s: f64,
     pub fz: f64,
     pub omega_re: f64,
+    /// Whether the force evaluation runs at a raised speed (|Vx| < VXLOW).
+    pub floored: bool,
+}
+
+impl StepCtx<'_> {
+    /// Low-speed offset correction (N): the MF's force at zero slip at the
+    /// actual speed (the probe, with the MF's own low-speed reduction of its
+    /// shifts) minus that at the raised speed of the force evaluation. Zero
+    /// from VXLOW up; below it one extra forces evaluation. Added to the
+    /// force evaluation, it keeps the MF's low-speed treatment of the shifts
+    /// (a parked car is not pushed by a camber thrust or SVx of rolling).
+    pub fn offset_correction(&self) -> (f64, f64) {
+        if !self.floored {
+            return (0.0, 0.0);
+        }
+        let f = mf_at(self.tyre, &self.base, self.mode, Slip::default(), self.s);
+        let d = |p: f64, f: f64| {
+            let x = self.s * p - f;
+            if x.is_finite() {
+                x
+            } else {
+                0.0
+            }
+        };
+        (d(self.props.fx0, f.fx), d(self.props.fy0, f.fy))
+    }
 }
 
 impl TransientModel {
@@ -632,6 +661,7 @@ impl TransientModel {
             s,
             fz,
             omega_re: inp.omega * props.re,
+            floored: fbase.vx != base.vx,
         };
         let mut next = self.state;
         let mut out = if fz <= FZ_OFF {
@@ -672,7 +702,11 @@ impl TransientModel {
                         b.phit = next.x[SLOT_PHI];
                     }
                     let sl = Slip::new(k, t);
-                    self.output(&ctx, &mf_at(tyre, &b, mode, sl, s), sl)
+                    let mut o = mf_at(tyre, &b, mode, sl, s);
+                    let (cx, cy) = ctx.offset_correction();
+                    o.fx += cx;
+                    o.fy += cy;
+                    self.output(&ctx, &o, sl)
                 }
                 _ => lugre::step(&ctx, &self.options.lugre, &mut next, dt),
             }

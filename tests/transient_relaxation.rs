@@ -427,7 +427,7 @@ fn relaxation_steady_state_is_the_magic_formula() {
             };
             let mut m = model_opts(TransientKind::Relaxation, InputMode::Velocities, o);
             // κ = −Vsx/|Vx| = (Ω·Re − Vx)/Vx, tan α = Vy/Vx.
-            let inp = vel(v, v * (a as f64).tan(), v * (1.0 + k) / r);
+            let inp = vel(v, v * f64::tan(a), v * (1.0 + k) / r);
             let mut out = Default::default();
             for _ in 0..3000 {
                 out = m.step(&tyre, &inp, 1e-3).unwrap();

@@ -617,8 +617,10 @@ impl TransientModel {
     /// return the outputs at the end of the step. On error the state is unchanged.
     ///
     /// Cost: one full Magic Formula evaluation (a zero-slip probe for Re, μ,
-    /// the stiffnesses and relaxation lengths) and one forces-only one; the
-    /// non-linear relaxation variant adds three per sub-step for the local slope.
+    /// the stiffnesses and relaxation lengths) and one forces-only one; below
+    /// VXLOW one more forces-only one (zero-slip offsets); the non-linear
+    /// relaxation variant adds three per slope evaluation (one per step when
+    /// the slips change little, two per sub-step otherwise).
     pub fn step(&mut self, tyre: &Tyre, inp: &WheelInput, dt: f64) -> crate::Result<WheelOutput> {
         let s = validate(self.config.input_mode, inp, dt)?;
         let fz = inp.fz.max(0.0);

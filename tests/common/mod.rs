@@ -1,4 +1,6 @@
-//! Helpers shared by the integration tests.
+//! Helpers shared by the integration tests: the shared-data path, reference
+//! CSV reading, and the transient tests' models, inputs and expectations.
+#![allow(dead_code, unused_imports)]
 
 use std::path::{Path, PathBuf};
 
@@ -37,4 +39,166 @@ pub fn reference_input(r: &[f64], col: impl Fn(&str) -> usize) -> tyrekit::mf::M
         p: r[col("in_P")],
         omega: r[col("in_omega")],
     }
+}
+
+
+use tyrekit::mf::{MfInput, MfOutput, Tyre, UseMode};
+use tyrekit::transient::{
+    InputMode, TransientConfig, TransientKind, TransientModel, TransientOptions, WheelInput,
+};
+
+pub const G: f64 = 9.81;
+
+/// Every transient model kind.
+pub const KINDS: [TransientKind; 3] = [
+    TransientKind::Steady,
+    TransientKind::Relaxation,
+    TransientKind::LuGre,
+];
+
+/// A velocity-input model of `kind` driven `n` steps of 1 ms with `inp`.
+pub fn driven(tyre: &Tyre, kind: TransientKind, n: usize, inp: WheelInput) -> TransientModel {
+    let mut m = model(kind, InputMode::Velocities);
+    for _ in 0..n {
+        m.step(tyre, &inp, 1e-3).expect("driving step");
+    }
+    m
+}
+pub const FZ: f64 = 4000.0;
+
+pub fn model(kind: TransientKind, mode: InputMode) -> TransientModel {
+    TransientModel::new(TransientConfig {
+        kind,
+        input_mode: mode,
+        use_mode: UseMode::default(),
+    })
+}
+
+pub fn model_opts(kind: TransientKind, mode: InputMode, o: TransientOptions) -> TransientModel {
+    TransientModel::with_options(
+        TransientConfig {
+            kind,
+            input_mode: mode,
+            use_mode: UseMode::default(),
+        },
+        o,
+    )
+}
+
+/// Prescribed-slip input at speed `vx`.
+pub fn slips(vx: f64, kappa: f64, alpha: f64) -> WheelInput {
+    WheelInput {
+        vx,
+        omega: 0.0,
+        fz: FZ,
+        mu_scale: 1.0,
+        kappa_in: kappa,
+        alpha_in: alpha,
+        ..Default::default()
+    }
+}
+
+/// Velocity input.
+pub fn vel(vx: f64, vy: f64, omega: f64) -> WheelInput {
+    WheelInput {
+        vx,
+        vy,
+        omega,
+        fz: FZ,
+        mu_scale: 1.0,
+        ..Default::default()
+    }
+}
+
+/// The steady Magic Formula at (κ, α) and speed vx, for the same load.
+pub fn mf(tyre: &Tyre, vx: f64, kappa: f64, alpha: f64) -> MfOutput {
+    tyre.evaluate(
+        &MfInput {
+            fz: FZ,
+            kappa,
+            alpha,
+            vx,
+            ..Default::default()
+        },
+        UseMode::default(),
+    )
+}
+
+/// Relaxation lengths the MF implies for this tyre at FZ (MfOutput σ when the
+/// MF gives them, else |K|/C from the MF's slip stiffnesses and the file's
+/// carcass stiffnesses — the documented fallback of a placeholder MF).
+pub fn mf_sigmas(tyre: &Tyre) -> (f64, f64) {
+    let o = mf(tyre, 20.0, 0.0, 0.0);
+    let p = &tyre.params().p;
+    let cx = if o.cx > 0.0 {
+        o.cx
+    } else {
+        p.longitudinal_stiffness
+    };
+    let cy = if o.cy > 0.0 {
+        o.cy
+    } else {
+        p.lateral_stiffness
+    };
+    let sx = if o.sigmax > 0.0 {
+        o.sigmax
+    } else {
+        o.kxk.abs() / cx
+    };
+    let sy = if o.sigmay > 0.0 {
+        o.sigmay
+    } else {
+        o.kya.abs() / cy
+    };
+    (sx, sy)
+}
+
+/// Carcass stiffnesses (N/m) the MF implies at FZ.
+pub fn carcass(tyre: &Tyre) -> (f64, f64) {
+    let o = mf(tyre, 0.0, 0.0, 0.0);
+    let p = &tyre.params().p;
+    (
+        if o.cx > 0.0 {
+            o.cx
+        } else {
+            p.longitudinal_stiffness
+        },
+        if o.cy > 0.0 {
+            o.cy
+        } else {
+            p.lateral_stiffness
+        },
+    )
+}
+
+/// Effective rolling radius the MF gives at FZ, speed vx.
+pub fn re(tyre: &Tyre, vx: f64) -> f64 {
+    let o = mf(tyre, vx, 0.0, 0.0);
+    if o.re > 0.0 {
+        o.re
+    } else {
+        tyre.params().p.unloaded_radius
+    }
+}
+
+/// Least-squares amplitude and phase (rad) of `y` against sin(ωt): y ≈ a·sin(ωt + φ) + c.
+pub fn fit_sine(t: &[f64], y: &[f64], w: f64) -> (f64, f64) {
+    // Normal equations for [sin, cos, 1].
+    let mut m = [[0.0f64; 3]; 3];
+    let mut b = [0.0f64; 3];
+    for (&ti, &yi) in t.iter().zip(y) {
+        let f = [(w * ti).sin(), (w * ti).cos(), 1.0];
+        for i in 0..3 {
+            for j in 0..3 {
+                m[i][j] += f[i] * f[j];
+            }
+            b[i] += f[i] * yi;
+        }
+    }
+    let a = nalgebra::Matrix3::from_fn(|i, j| m[i][j]);
+    let x = a
+        .lu()
+        .solve(&nalgebra::Vector3::new(b[0], b[1], b[2]))
+        .expect("regular normal equations");
+    (x[0].hypot(x[1]), x[1].atan2(x[0]))
 }

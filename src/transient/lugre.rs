@@ -1,0 +1,398 @@
+//! lugre — the average lumped LuGre tyre friction model (Canudas de Wit,
+//! Tsiotras, Velenis, Basset & Gissinger, "Dynamic friction models for road/tire
+//! longitudinal interaction", Vehicle System Dynamics 39(3), 2003; Tsiotras,
+//! Velenis & Sorine 2004 for the combined-slip form), fed by the Magic Formula.
+//!
+//! Per direction i ∈ {x, y}, with the relative (sliding) velocity vr
+//! (vr_x = −Vsx = κ·|Vx|, vr_y = −Vsy, so that forces have the sign of vr):
+//!
+//! ```text
+//!   dz_i/dt = vr_i − θ_i·z_i
+//!   F_i     = Fz·(σ0_i·z_i + σ1_i·dz_i/dt + σ2·vr_i)
+//! ```
+//! with the bristle "rate" θ_i = σ0_i·|vr|/g + κ_L·|Ω·Re| (the average lumped
+//! form: the second term is the distributed bristle transport, Canudas de Wit
+//! et al. 2003 eq. 11 with κ_L constant).
+//!
+//! Friction function g:
+//! * [`LuGreFriction::MagicFormula`] (default): g is derived from the Magic
+//!   Formula curve of the same tyre, per direction, so that the steady state
+//!   (ż = 0: F_i = Fz·σ0_i·vr_i/θ_i) equals the MF force at the same
+//!   (combined) slips. The MF's force at zero slip F_i,0 (shifts SH/SV,
+//!   camber thrust, from the zero-slip probe at the actual speed) is carried
+//!   directly, F_i = F_i,0 + Fz·(σ0_i·z_i + …), and the bristles carry the
+//!   slip-generated part ΔF_i = F_i,MF(κ, α) − F_i,0, which has the sign of
+//!   vr_i for any MF curve through the origin of ΔF:
+//!   θ_i = Fz·σ0_i·|vr_i|/(|ΔF_i|·S(‖vr‖)), where the Stribeck factor
+//!   S = 1 + (μs/μc − 1)·exp(−(‖vr‖/vs)^δ) is 1 by default. Steady state:
+//!   F_i = F_i,0 + ΔF_i = F_i,MF exactly. Combined-slip coupling is that of the
+//!   MF (its combined-slip weights). Below VXLOW, where the MF evaluation runs
+//!   at a raised speed, ΔF is taken against that evaluation's own zero-slip
+//!   force, while F_i,0 keeps the MF's low-speed reduction of its shifts.
+//! * [`LuGreFriction::Stribeck`]: the classical isotropic Stribeck curve
+//!   g(‖vr‖) = μc + (μs − μc)·exp(−(‖vr‖/vs)^δ) with θ_i = σ0_i‖vr‖/g + κ_L|ΩRe|.
+//!
+//! Defaults: σ0_i = C_i/Fz (bristle stiffness = carcass stiffness, so at small
+//! slip LuGre behaves as the relaxation model with σ = K/C), σ1_i = c_i/Fz
+//! (the low-speed damping of the relaxation model), σ2 = 0, κ_L = 0.
+//!
+//! Low speed (below VXLOW, blended with the same weight w as the relaxation
+//! damping): the elasto-plastic form of Dupont, Hayward, Armstrong & Altpeter
+//! ("Single state elastoplastic friction models", IEEE TAC 47(5), 2002)
+//! multiplies the bristle-rate term by a(z) = 1 − w·(1 − α(z)), α = 0 while
+//! |z| < β·z_ss or while the bristle unloads (sgn z ≠ sgn vr), rising smoothly
+//! to 1 at z_ss. Without it LuGre drifts under an oscillating load (a parked
+//! car rocking on its tyres creeps downhill); with it, presliding is purely
+//! elastic. In steady state |z| = z_ss, α = 1, so the steady forces are unchanged.
+//!
+//! From VXLOW up θ depends only on the inputs, so over a step with held inputs
+//! the bristle equations are linear with constant coefficients and are solved
+//! exactly. Below VXLOW a(z) is frozen over sub-steps short enough that z
+//! moves by at most 5 % of z_ss per sub-step (at most 32, deterministic).
+//!
+//! Parameters may come from a `[LUGRE]` section of the `.tir`
+//! ([`LuGreParams::from_tir_text`], [`LuGreParams::to_tir_section`]); keys
+//! (SI): `SIGMA0X`, `SIGMA0Y` (1/m), `SIGMA1X`, `SIGMA1Y` (s/m), `SIGMA2` (s/m),
+//! `MUC`, `MUS` (–), `VS` (m/s), `DELTA` (–, Stribeck exponent), `KAPPA_L`
+//! (1/m), `BREAKAWAY` (–). A zero SIGMA* means "derive the default". `MUC` > 0 selects the
+//! Stribeck friction function; otherwise `MUS` is the ratio μs/μc applied to
+//! the Magic Formula curve.
+//!
+//! Must never: allocate in `step`, divide by a speed or a force without a guard.
+
+use super::{mf_at, relax_exact, Slip, StepCtx, TransientState, WheelOutput, SLOT_X, SLOT_Y};
+
+/// Which friction function the bristles saturate at.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum LuGreFriction {
+    /// Derived from the Magic Formula of the same tyre (steady state = MF).
+    #[default]
+    MagicFormula,
+    /// The classical Stribeck curve from `mu_c`, `mu_s`, `vs`, `delta`.
+    Stribeck,
+}
+
+/// LuGre parameters. Zero σ's mean "derive from the tyre" (see module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LuGreParams {
+    pub friction: LuGreFriction,
+    /// Bristle stiffness per unit normal load (1/m), longitudinal / lateral; 0 = C/Fz.
+    pub sigma0x: f64,
+    pub sigma0y: f64,
+    /// Bristle damping per unit normal load (s/m); 0 = low-speed damping c/Fz.
+    pub sigma1x: f64,
+    pub sigma1y: f64,
+    /// Viscous friction per unit normal load (s/m).
+    pub sigma2: f64,
+    /// Coulomb friction coefficient (Stribeck curve).
+    pub mu_c: f64,
+    /// Static friction coefficient (Stribeck curve); with the MF curve, the
+    /// ratio μs/μc of the Stribeck factor (1 = none).
+    pub mu_s: f64,
+    /// Stribeck velocity (m/s).
+    pub vs: f64,
+    /// Stribeck exponent (–).
+    pub delta: f64,
+    /// Average-lumped distributed-bristle coefficient κ_L (1/m).
+    pub kappa_l: f64,
+    /// Breakaway ratio β = z_ba/z_ss of the elasto-plastic low-speed form (–, 0..1).
+    pub breakaway: f64,
+}
+
+impl Default for LuGreParams {
+    /// MF-derived friction, derived stiffness and damping, no Stribeck peak;
+    /// vs = 3.5 m/s and δ = 1 are typical dry-asphalt values (Canudas de Wit et al. 2003).
+    fn default() -> Self {
+        LuGreParams {
+            friction: LuGreFriction::MagicFormula,
+            sigma0x: 0.0,
+            sigma0y: 0.0,
+            sigma1x: 0.0,
+            sigma1y: 0.0,
+            sigma2: 0.0,
+            mu_c: 0.0,
+            mu_s: 1.0,
+            vs: 3.5,
+            delta: 1.0,
+            kappa_l: 0.0,
+            breakaway: 0.5,
+        }
+    }
+}
+
+/// Names of the `[LUGRE]` keys, in writer order.
+pub const LUGRE_KEYS: [&str; 11] = [
+    "SIGMA0X",
+    "SIGMA0Y",
+    "SIGMA1X",
+    "SIGMA1Y",
+    "SIGMA2",
+    "MUC",
+    "MUS",
+    "VS",
+    "DELTA",
+    "KAPPA_L",
+    "BREAKAWAY",
+];
+
+impl LuGreParams {
+    /// From a key lookup (for the `.tir` reader's custom-section API): `get(KEY)`
+    /// returns the SI value of a `[LUGRE]` key if the file has it. Values are
+    /// checked (finite, non-negative; VS, DELTA > 0).
+    pub fn from_lookup(get: impl Fn(&str) -> Option<f64>) -> crate::Result<Self> {
+        let mut p = LuGreParams::default();
+        for key in LUGRE_KEYS {
+            let Some(x) = get(key) else { continue };
+            let positive = matches!(key, "VS" | "DELTA");
+            if !x.is_finite() || x < 0.0 || (positive && x == 0.0) {
+                return Err(crate::Error::Tir {
+                    file: String::new(),
+                    line: 0,
+                    key: key.to_string(),
+                    message: format!(
+                        "[LUGRE] {key} = {x}: expected a finite number {}",
+                        if positive { "> 0" } else { ">= 0" }
+                    ),
+                });
+            }
+            match key {
+                "SIGMA0X" => p.sigma0x = x,
+                "SIGMA0Y" => p.sigma0y = x,
+                "SIGMA1X" => p.sigma1x = x,
+                "SIGMA1Y" => p.sigma1y = x,
+                "SIGMA2" => p.sigma2 = x,
+                "MUC" => p.mu_c = x,
+                "MUS" => p.mu_s = x,
+                "VS" => p.vs = x,
+                "DELTA" => p.delta = x,
+                "KAPPA_L" => p.kappa_l = x,
+                _ => p.breakaway = x.min(0.99),
+            }
+        }
+        if p.mu_c > 0.0 {
+            p.friction = LuGreFriction::Stribeck;
+            if get("MUS").is_none() {
+                p.mu_s = p.mu_c;
+            }
+        }
+        Ok(p)
+    }
+
+    /// Read the `[LUGRE]` section of `.tir` text (SI values, `$` comments);
+    /// defaults when the section is absent. Stop-gap until the `.tir` reader
+    /// exposes custom sections; errors name the file and line.
+    pub fn from_tir_text(text: &str, name: &str) -> crate::Result<Self> {
+        let mut vals = [None::<(f64, usize)>; LUGRE_KEYS.len()];
+        let mut inside = false;
+        for (i, raw) in text.lines().enumerate() {
+            let line = raw.split(['$', '!']).next().unwrap_or("").trim();
+            if line.starts_with('[') {
+                inside = line.eq_ignore_ascii_case("[LUGRE]");
+                continue;
+            }
+            if !inside {
+                continue;
+            }
+            let Some((k, v)) = line.split_once('=') else {
+                continue;
+            };
+            let k = k.trim().to_ascii_uppercase();
+            let Some(idx) = LUGRE_KEYS.iter().position(|n| *n == k) else {
+                continue;
+            };
+            let x: f64 = v.trim().parse().map_err(|_| crate::Error::Tir {
+                file: name.to_string(),
+                line: i + 1,
+                key: k.clone(),
+                message: format!("expected a number, found '{}'", v.trim()),
+            })?;
+            vals[idx] = Some((x, i + 1));
+        }
+        let lookup = |key: &str| {
+            LUGRE_KEYS
+                .iter()
+                .position(|n| *n == key)
+                .and_then(|i| vals[i].map(|v| v.0))
+        };
+        LuGreParams::from_lookup(lookup).map_err(|e| match e {
+            crate::Error::Tir { key, message, .. } => {
+                let line = LUGRE_KEYS
+                    .iter()
+                    .position(|n| *n == key)
+                    .and_then(|i| vals[i].map(|v| v.1))
+                    .unwrap_or(0);
+                crate::Error::Tir {
+                    file: name.to_string(),
+                    line,
+                    key,
+                    message,
+                }
+            }
+            other => other,
+        })
+    }
+
+    /// The `[LUGRE]` section as `.tir` text (for the writer).
+    pub fn to_tir_section(&self) -> String {
+        let vals = [
+            self.sigma0x,
+            self.sigma0y,
+            self.sigma1x,
+            self.sigma1y,
+            self.sigma2,
+            if self.friction == LuGreFriction::Stribeck {
+                self.mu_c
+            } else {
+                0.0
+            },
+            self.mu_s,
+            self.vs,
+            self.delta,
+            self.kappa_l,
+            self.breakaway,
+        ];
+        let mut s = String::from("[LUGRE]\n");
+        for (k, v) in LUGRE_KEYS.iter().zip(vals) {
+            s.push_str(&format!("{k} = {v:e}\n"));
+        }
+        s
+    }
+}
+
+/// Stribeck shape exp(−(v/vs)^δ) (0..1).
+#[inline]
+fn stribeck_shape(v: f64, p: &LuGreParams) -> f64 {
+    let r = v / p.vs;
+    if p.delta == 1.0 {
+        (-r).exp()
+    } else {
+        (-r.powf(p.delta)).exp()
+    }
+}
+
+/// Elasto-plastic factor α(z) of Dupont et al. 2002: 0 below the breakaway
+/// β·z_ss and while unloading, 1 at and above z_ss, a half sine in between.
+#[inline]
+fn elastoplastic(z: f64, zss: f64, vr: f64, beta: f64) -> f64 {
+    let valid = zss.is_finite() && zss > 0.0;
+    if !valid {
+        // No steady bristle deflection to compare with (no sliding): plain LuGre.
+        return 1.0;
+    }
+    if z * vr <= 0.0 {
+        // Unloading (or at rest): elastic.
+        return 0.0;
+    }
+    let r = z.abs() / zss;
+    if r >= 1.0 {
+        1.0
+    } else if r <= beta {
+        0.0
+    } else {
+        let x = (r - 0.5 * (1.0 + beta)) / (1.0 - beta);
+        0.5 + 0.5 * (std::f64::consts::PI * x).sin()
+    }
+}
+
+/// One LuGre step (see the module docs); updates slots 0, 1 of `st`.
+pub(crate) fn step(c: &StepCtx, p: &LuGreParams, st: &mut TransientState, dt: f64) -> WheelOutput {
+    let fz = c.fz;
+    let vrx = -c.kin.vsx;
+    let vry = -c.kin.vsy;
+    let vr = (vrx * vrx + vry * vry).sqrt();
+    let pos = |x: f64, fb: f64| if x > 0.0 { x } else { fb };
+    let s0x = pos(p.sigma0x, c.props.cx / fz);
+    let s0y = pos(p.sigma0y, c.props.cy / fz);
+    let s1x = pos(p.sigma1x, c.props.damp_x_full / fz);
+    let s1y = pos(p.sigma1y, c.props.damp_y_full / fz);
+    let transport = p.kappa_l * c.omega_re.abs();
+    // Steady MF at the kinematic slips (also the moments and μ outputs).
+    let o = mf_at(c.tyre, &c.base, c.mode, Slip::of(&c.kin), c.s);
+    // Force at zero slip (MF mode only): carried directly, not by the bristles.
+    // ΔF is taken against the zero-slip force of the same (raised-speed)
+    // evaluation, so it is zero at zero slip at every speed.
+    let (f0x, f0y, b0x, b0y) = match p.friction {
+        LuGreFriction::MagicFormula => {
+            let (f0x, f0y) = (c.s * c.props.fx0, c.s * c.props.fy0);
+            let (cx, cy) = c.offset_correction();
+            (f0x, f0y, f0x - cx, f0y - cy)
+        }
+        LuGreFriction::Stribeck => (0.0, 0.0, 0.0, 0.0),
+    };
+    let (thx, thy) = match p.friction {
+        LuGreFriction::MagicFormula => {
+            let strib = if p.mu_s != 1.0 {
+                1.0 + (p.mu_s - 1.0) * stribeck_shape(vr, p)
+            } else {
+                1.0
+            };
+            // θ = Fz·σ0·|vr_i| / (|ΔF_i|·S); ΔF floored at 1e-9·Fz (θ then
+            // just very large: z follows vr/θ ≈ 0, i.e. no slip force, as the MF says).
+            let th = |s0: f64, v: f64, f: f64| {
+                fz * s0 * v.abs() / (f.abs() * strib).max(1e-9 * fz) + transport
+            };
+            (th(s0x, vrx, o.fx - b0x), th(s0y, vry, o.fy - b0y))
+        }
+        LuGreFriction::Stribeck => {
+            let g = (p.mu_c + (p.mu_s - p.mu_c) * stribeck_shape(vr, p)) * c.s;
+            let g = g.max(1e-9);
+            (s0x * vr / g + transport, s0y * vr / g + transport)
+        }
+    };
+    // z_ss per direction (for the elasto-plastic factor): g_i/σ0_i.
+    let (zssx, zssy) = (
+        (vrx / (thx - transport)).abs(),
+        (vry / (thy - transport)).abs(),
+    );
+    let w = c.props.weight;
+    let (mut zx, mut zy) = (st.x[SLOT_X], st.x[SLOT_Y]);
+    let (mut thx_e, mut thy_e) = (thx, thy);
+    if w > 0.0 {
+        let rate = |th: f64, z: f64, zss: f64, vr: f64| {
+            let a = 1.0 - w * (1.0 - elastoplastic(z, zss, vr, p.breakaway));
+            (th - transport) * a + transport
+        };
+        let lim = 0.05 * zssx.min(zssy).max(1e-9);
+        let n = ((vr * dt / lim).ceil() as usize).clamp(1, 32);
+        let h = dt / n as f64;
+        for _ in 0..n {
+            thx_e = rate(thx, zx, zssx, vrx);
+            thy_e = rate(thy, zy, zssy, vry);
+            zx = relax_exact(zx, thx_e, vrx, h);
+            zy = relax_exact(zy, thy_e, vry, h);
+        }
+    } else {
+        zx = relax_exact(zx, thx, vrx, dt);
+        zy = relax_exact(zy, thy, vry, dt);
+    }
+    st.x[SLOT_X] = zx;
+    st.x[SLOT_Y] = zy;
+    let dzx = vrx - thx_e * zx;
+    let dzy = vry - thy_e * zy;
+    let fx = f0x + fz * (s0x * zx + s1x * dzx + p.sigma2 * vrx);
+    let fy = f0y + fz * (s0y * zy + s1y * dzy + p.sigma2 * vry);
+    // Aligning moment: the MF's, scaled by the ratio of dynamic to steady Fy
+    // (the pneumatic trail of the steady state; bounded to stay sane when
+    // the steady Fy is near zero).
+    let mz = if o.fy.abs() > 1e-6 * fz {
+        o.mz * (fy / o.fy).clamp(-2.0, 2.0)
+    } else {
+        0.0
+    };
+    WheelOutput {
+        fx,
+        fy,
+        mx: o.mx,
+        my: o.my,
+        mz,
+        kappa: c.kin.kappa,
+        alpha: c.kin.alpha,
+        re: c.props.re,
+        mux: c.s * c.props.mux,
+        muy: c.s * c.props.muy,
+        vsx: c.kin.vsx,
+        vsy: c.kin.vsy,
+        sigma_x: c.props.sigma_x,
+        sigma_y: c.props.sigma_y,
+    }
+}

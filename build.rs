@@ -35,6 +35,7 @@ struct Var {
     initial: Option<String>,
     start: Option<String>,
     unit: Option<String>,
+    description: String,
     line: u32,
 }
 
@@ -274,6 +275,7 @@ fn main() {
             initial,
             start,
             unit,
+            description: sv.attribute("description").unwrap_or("").to_string(),
             line,
         });
     }
@@ -497,13 +499,14 @@ fn main() {
         };
         let _ = writeln!(
             out,
-            "    VarInfo {{ vr: {}, name: {:?}, ty: VarType::{}, slot: {s}, causality: Causality::{}, variability: Variability::{}, start: {start}, unit: {:?} }},",
+            "    VarInfo {{ vr: {}, name: {:?}, ty: VarType::{}, slot: {s}, causality: Causality::{}, variability: Variability::{}, start: {start}, unit: {:?}, description: {:?} }},",
             v.vr,
             v.name,
             v.ty,
             cap(&v.causality),
             cap(&v.variability),
-            v.unit.as_deref().unwrap_or("")
+            v.unit.as_deref().unwrap_or(""),
+            v.description
         );
     }
     let _ = writeln!(out, "];");

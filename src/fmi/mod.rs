@@ -18,6 +18,7 @@
 pub mod exports;
 pub mod instance;
 pub mod logging;
+pub mod master;
 pub mod resources;
 pub mod snapshot;
 pub mod spec;
@@ -26,3 +27,6 @@ pub mod vars;
 
 pub use instance::Instance;
 pub use vars::{GUID, MODEL_DESCRIPTION_XML, MODEL_IDENTIFIER};
+
+#[path = "../../packaging/mod.rs"]
+pub mod packaging;

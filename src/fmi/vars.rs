@@ -68,6 +68,7 @@ pub struct VarInfo {
     pub variability: Variability,
     pub start: Start,
     pub unit: &'static str,
+    pub description: &'static str,
 }
 
 include!(concat!(env!("OUT_DIR"), "/fmi_vars.rs"));

@@ -81,7 +81,8 @@ impl Logger {
             callbacks,
             instance_name: to_cstring(instance_name),
             debug,
-            enabled: [true; 5],
+            // Status categories on; the debug categories follow loggingOn.
+            enabled: [debug, true, true, true, debug],
         }
     }
 

@@ -43,7 +43,9 @@ fn fmi_crate_runs_the_fmu_like_the_library() {
     let inputs = ["vx", "vy", "omega", "Fz", "gamma"].map(|n| vr(&import, n));
     let outputs = ["Fx", "Fy", "Mx", "My", "Mz", "kappa", "alpha"].map(|n| vr(&import, n));
 
-    let mut inst = import.instantiate_cs("rust-fmi", false, false).expect("instantiate");
+    let mut inst = import
+        .instantiate_cs("rust-fmi", false, false)
+        .expect("instantiate");
     // Wrong state: stepping before initialisation is refused.
     assert!(inst.do_step(0.0, 1e-3, true).is_err());
     inst.setup_experiment(None, 0.0, None).expect("setup");
@@ -56,7 +58,13 @@ fn fmi_crate_runs_the_fmu_like_the_library() {
     let mut y = [0.0; 7];
     let mut max_fy: f64 = 0.0;
     for k in 0..500 {
-        let u = [20.0, -2.0 + 0.008 * k as f64, 63.0 + 0.01 * k as f64, 4000.0, 0.01];
+        let u = [
+            20.0,
+            -2.0 + 0.008 * k as f64,
+            63.0 + 0.01 * k as f64,
+            4000.0,
+            0.01,
+        ];
         inst.set_real(&inputs, &u).expect("set inputs");
         inst.do_step(k as f64 * h, h, true).expect("step");
         inst.get_real(&outputs, &mut y).expect("get outputs");
@@ -89,7 +97,8 @@ fn fmi_crate_runs_the_fmu_like_the_library() {
     assert!(max_fy > 100.0, "the sweep produced lateral force");
     // Bad input through this importer too: refused, next step fine.
     assert!(inst.set_real(&inputs[..1], &[f64::NAN]).is_err());
-    inst.do_step(500.0 * h, h, true).expect("step after refused input");
+    inst.do_step(500.0 * h, h, true)
+        .expect("step after refused input");
     inst.terminate().expect("terminate");
 }
 
@@ -100,7 +109,9 @@ fn fmi_crate_two_instances_are_independent() {
     let vy = vr(&import, "vy");
     let fy = vr(&import, "Fy");
     let start = |name: &str| {
-        let mut i = import.instantiate_cs(name, false, false).expect("instantiate");
+        let mut i = import
+            .instantiate_cs(name, false, false)
+            .expect("instantiate");
         i.setup_experiment(None, 0.0, None).expect("setup");
         i.enter_initialization_mode().expect("enter");
         i.exit_initialization_mode().expect("exit");

@@ -227,3 +227,57 @@ pub fn deserialize(inst: &Instance, bytes: &[u8]) -> Result<Sim, String> {
         loaded,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fmi::logging::Logger;
+
+    fn instance() -> (Box<Instance>, std::path::PathBuf) {
+        let dir = std::env::temp_dir().join(format!(
+            "tyrekit-snapshot-{}-{:?}",
+            std::process::id(),
+            std::thread::current().id()
+        ));
+        std::fs::create_dir_all(&dir).unwrap();
+        crate::tir::TyreParams::builtin()
+            .write(&dir.join("tyre.tir"))
+            .unwrap();
+        let inst = Instance::new(Logger::new(None, "t", false), Some(dir.to_str().unwrap()))
+            .map_err(|(_, e)| e)
+            .unwrap();
+        (inst, dir)
+    }
+
+    #[test]
+    fn round_trip_is_exact() {
+        let (mut inst, dir) = instance();
+        inst.sim.phase = Phase::StepComplete;
+        inst.sim.values.reals[crate::fmi::vars::real::VY] = 0.7;
+        inst.do_step(0.0, 1e-3).unwrap();
+        inst.sim.model.state.x = [1.0, -2.0, 3.5, 0.0, 1e-300, -0.0, 7.0, 8.0];
+        let bytes = serialize(&inst.sim);
+        let back = deserialize(&inst, &bytes).unwrap();
+        assert_eq!(back.values, inst.sim.values);
+        assert_eq!(back.model.state, inst.sim.model.state);
+        assert_eq!(back.time, inst.sim.time);
+        assert_eq!(back.phase, inst.sim.phase);
+        assert_eq!(serialize(&back), bytes);
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    #[test]
+    fn every_truncation_and_byte_flip_is_refused() {
+        let (inst, dir) = instance();
+        let bytes = serialize(&inst.sim);
+        for n in 0..bytes.len() {
+            assert!(deserialize(&inst, &bytes[..n]).is_err(), "truncated to {n}");
+        }
+        for i in 0..bytes.len() {
+            let mut b = bytes.clone();
+            b[i] ^= 0x5a;
+            assert!(deserialize(&inst, &b).is_err(), "byte {i} flipped");
+        }
+        let _ = std::fs::remove_dir_all(dir);
+    }
+}

@@ -298,18 +298,18 @@ impl Sim {
                 return Err(format!("input {name} = {} {why}", r[slot]));
             }
         }
-        let m = if self.mirror { -1.0 } else { 1.0 };
+        let m = self.mirror;
         let inp = WheelInput {
             vx: r[real::VX],
-            vy: m * r[real::VY],
+            vy: flip(m, r[real::VY]),
             omega: r[real::OMEGA],
             fz: r[real::FZ],
-            gamma: m * r[real::GAMMA],
+            gamma: flip(m, r[real::GAMMA]),
             p: r[real::P],
-            phit: m * r[real::PHIT],
+            phit: flip(m, r[real::PHIT]),
             mu_scale: r[real::MU_SCALE],
             kappa_in: r[real::KAPPA_IN],
-            alpha_in: m * r[real::ALPHA_IN],
+            alpha_in: flip(m, r[real::ALPHA_IN]),
         };
         let saved = model.state;
         let mut out = match model.step(&self.loaded.tyre, &inp, dt) {
@@ -349,21 +349,31 @@ impl Sim {
         }
         let r = &mut self.values.reals;
         r[real::FX] = out.fx;
-        r[real::FY] = m * out.fy;
-        r[real::MX] = m * out.mx;
+        r[real::FY] = flip(m, out.fy);
+        r[real::MX] = flip(m, out.mx);
         r[real::MY] = out.my;
-        r[real::MZ] = m * out.mz;
+        r[real::MZ] = flip(m, out.mz);
         r[real::KAPPA] = out.kappa;
-        r[real::ALPHA] = m * out.alpha;
+        r[real::ALPHA] = flip(m, out.alpha);
         r[real::RE] = out.re;
         r[real::MUX] = out.mux;
         r[real::MUY] = out.muy;
         r[real::VSX] = out.vsx;
-        r[real::VSY] = m * out.vsy;
+        r[real::VSY] = flip(m, out.vsy);
         r[real::SIGMA_X] = out.sigma_x;
         r[real::SIGMA_Y] = out.sigma_y;
         self.values.booleans[boolean::CONTACT] = contact;
         Ok(())
+    }
+}
+
+/// Mirror a lateral quantity when `mirror` (as `0 - x`, so that a zero stays +0).
+#[inline]
+fn flip(mirror: bool, x: f64) -> f64 {
+    if mirror {
+        0.0 - x
+    } else {
+        x
     }
 }
 

@@ -262,7 +262,7 @@ fn main() {
         }
         if sv
             .attribute("description")
-            .map_or(true, |d| d.trim().is_empty())
+            .is_none_or(|d| d.trim().is_empty())
         {
             fail(format!("line {line}: {name}: missing description"));
         }

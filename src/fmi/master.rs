@@ -90,10 +90,18 @@ pub fn callbacks() -> fmi2CallbackFunctions {
         fmi2String,
         fmi2String,
     );
+    type Variadic = unsafe extern "C" fn(
+        fmi2ComponentEnvironment,
+        fmi2String,
+        Fmi2Status,
+        fmi2String,
+        fmi2String,
+        ...
+    );
     let f: Fixed = print_logger;
     fmi2CallbackFunctions {
         // SAFETY: see the module header (x86-64 SysV; the FMU always passes "%s" + one string).
-        logger: Some(unsafe { std::mem::transmute::<Fixed, _>(f) }),
+        logger: Some(unsafe { std::mem::transmute::<Fixed, Variadic>(f) }),
         allocate_memory: None,
         free_memory: None,
         step_finished: None,

@@ -532,6 +532,9 @@ impl Instance {
                 self.sim.time
             ));
         }
+        // stopTime is not enforced: the tyre has no end of validity in time, and
+        // common masters (fmi-sim) take a last step past stopTime when the step
+        // does not divide the interval.
         let mut model = self.sim.model.clone();
         self.sim.compute(h, &mut model)?;
         self.sim.model = model;

@@ -293,10 +293,13 @@ impl Sim {
     /// unless it fails.
     pub fn compute(&mut self, dt: f64, model: &mut TransientModel) -> Result<(), String> {
         let r = &self.values.reals;
-        for (slot, name) in INPUTS {
-            if let Some(why) = input_problem(slot, r[slot]) {
-                return Err(format!("input {name} = {} {why}", r[slot]));
-            }
+        // Fast check first (no branch per input); the message only on failure.
+        let mut ok = r[real::P] >= 0.0 && r[real::MU_SCALE] >= 0.0;
+        for (slot, _) in INPUTS {
+            ok &= r[slot].is_finite();
+        }
+        if !ok {
+            return Err(input_error(r));
         }
         let m = self.mirror;
         let inp = WheelInput {
@@ -323,20 +326,18 @@ impl Sim {
             }
         };
         let contact = inp.fz > 0.0;
-        let fields = output_fields(&mut out);
         if contact {
-            if let Some((name, v)) = fields.iter().find(|(_, v)| !v.is_finite()) {
-                let name = *name;
-                let v = **v;
+            let mut finite = true;
+            for v in output_fields(&mut out) {
+                finite &= v.1.is_finite();
+            }
+            if !finite {
                 model.state = saved;
-                return Err(format!(
-                    "tyre model returned {name} = {v} for vx={} vy={} omega={} Fz={} gamma={} (inputs left as they were)",
-                    inp.vx, inp.vy, inp.omega, inp.fz, inp.gamma
-                ));
+                return Err(output_error(&mut out, &inp));
             }
         } else {
             // Off the ground: no force, no moment; nothing undefined leaks out.
-            for (_, v) in fields {
+            for (_, v) in output_fields(&mut out) {
                 if !v.is_finite() {
                     *v = 0.0;
                 }
@@ -365,6 +366,31 @@ impl Sim {
         self.values.booleans[boolean::CONTACT] = contact;
         Ok(())
     }
+}
+
+/// The message for refused inputs (cold path).
+#[cold]
+fn input_error(r: &[f64]) -> String {
+    for (slot, name) in INPUTS {
+        if let Some(why) = input_problem(slot, r[slot]) {
+            return format!("input {name} = {} {why}", r[slot]);
+        }
+    }
+    "inputs refused".into()
+}
+
+/// The message for a non-finite model output (cold path).
+#[cold]
+fn output_error(out: &mut WheelOutput, inp: &WheelInput) -> String {
+    let bad = output_fields(out)
+        .into_iter()
+        .find(|(_, v)| !v.is_finite())
+        .map(|(n, v)| format!("{n} = {v}"))
+        .unwrap_or_default();
+    format!(
+        "tyre model returned {bad} for vx={} vy={} omega={} Fz={} gamma={} (nothing changed)",
+        inp.vx, inp.vy, inp.omega, inp.fz, inp.gamma
+    )
 }
 
 /// Mirror a lateral quantity when `mirror` (as `0 - x`, so that a zero stays +0).
@@ -398,16 +424,24 @@ fn output_fields(o: &mut WheelOutput) -> [(&'static str, &mut f64); 14] {
 }
 
 /// Look up a value reference of the expected type.
+#[inline]
 fn var(vr: u32, ty: VarType) -> Result<&'static VarInfo, String> {
     match vars::lookup(vr) {
-        None => Err(format!("unknown valueReference {vr}")),
-        Some(v) if v.ty != ty => Err(format!(
+        Some(v) if v.ty == ty => Ok(v),
+        other => Err(var_error(vr, ty, other)),
+    }
+}
+
+#[cold]
+fn var_error(vr: u32, ty: VarType, found: Option<&VarInfo>) -> String {
+    match found {
+        None => format!("unknown valueReference {vr}"),
+        Some(v) => format!(
             "valueReference {vr} is {} ({}), not a {}",
             v.name,
             v.ty.name(),
             ty.name()
-        )),
-        Some(v) => Ok(v),
+        ),
     }
 }
 

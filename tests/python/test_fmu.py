@@ -316,6 +316,14 @@ def test_transient_models_step_or_say_why(make, vr, log):
         except FMICallException as e:
             assert e.status == FMI2_ERROR
             assert any(kind in m for m in log.errors()), log.text()
+            # The instance is in the error state: no stepping, but reset recovers it.
+            expect_error(lambda: fmu.doStep(0.0, 1e-3), log, "not allowed in state error")
+            fmu.reset()
+            fmu.setString([vr["transient"]], ["steady"])
+            fmu.setupExperiment(startTime=0.0)
+            fmu.enterInitializationMode()
+            fmu.exitInitializationMode()
+            assert all(math.isfinite(v) for v in step(fmu, vr, 0.0, 1e-3, vy=0.5).values())
             continue
         for k in range(20):
             o = step(fmu, vr, k * 1e-3, 1e-3, vy=0.5)

@@ -8,7 +8,6 @@ use fmi::traits::FmiImport;
 use std::path::PathBuf;
 use tyrekit::fmi::packaging;
 use tyrekit::mf::Tyre;
-use tyrekit::tir::TyreParams;
 use tyrekit::transient::{TransientConfig, TransientModel, WheelInput};
 
 /// A freshly packaged FMU of this build (own path: tests run in parallel).
@@ -52,7 +51,10 @@ fn fmi_crate_runs_the_fmu_like_the_library() {
     inst.enter_initialization_mode().expect("enter init");
     inst.exit_initialization_mode().expect("exit init");
 
-    let tyre = Tyre::new(TyreParams::builtin()).expect("built-in tyre");
+    // The very file the FMU loaded (so the test does not depend on the .tir
+    // writer/reader round trip being exact).
+    let tir = import.archive_path().join("resources").join("tyre.tir");
+    let tyre = Tyre::from_file(&tir).expect("packaged tyre file");
     let mut model = TransientModel::new(TransientConfig::default());
     let h = 1e-3;
     let mut y = [0.0; 7];

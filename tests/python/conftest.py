@@ -129,11 +129,13 @@ def make(md, unzipdir, log):
 
 
 @pytest.fixture(scope="session")
-def reference():
-    """reference(rows, use_mode=111) -> array of Fx,Fy,Mx,My,Mz from Tyre::evaluate.
+def reference(unzipdir):
+    """reference(rows, use_mode=111) -> array of Fx,Fy,Mx,My,Mz from Tyre::evaluate
+    of the very tyre file the FMU loads (resources/tyre.tir of the package).
 
     rows: N x 8 array in MFeval's order Fz, kappa, alpha, gamma, phit, Vx, P, omega.
     """
+    tir = os.path.join(unzipdir, "resources", "tyre.tir")
     if not REFERENCE.exists():
         _cargo("build", "--release", "--quiet", "--example", "mf_reference")
 
@@ -142,7 +144,7 @@ def reference():
             ",".join(repr(float(x)) for x in r) for r in rows
         )
         out = subprocess.run(
-            [str(REFERENCE), "eval", str(use_mode)], input=text, capture_output=True, text=True, check=True
+            [str(REFERENCE), "eval", str(use_mode), tir], input=text, capture_output=True, text=True, check=True
         ).stdout
         return np.array([[float(x) for x in line.split(",")] for line in out.splitlines()[1:]])
 

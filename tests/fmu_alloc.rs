@@ -1,0 +1,80 @@
+//! The FMU's per-step path allocates nothing: fmi2SetReal (inputs) → fmi2DoStep →
+//! fmi2GetReal (outputs), called through the exported C functions, is run with a
+//! counting global allocator (this test binary only) and must make 0 allocations.
+//! One test in this binary on purpose: the counter sees every thread.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::ffi::CString;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use tyrekit::fmi::exports::*;
+use tyrekit::fmi::types::{Fmi2Status, FMI2_CO_SIMULATION};
+use tyrekit::fmi::vars::vr;
+
+struct Counting;
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        System.alloc(l)
+    }
+    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        System.dealloc(p, l)
+    }
+    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        System.realloc(p, l, n)
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn step_path_does_not_allocate() {
+    let dir = std::env::temp_dir().join(format!("tyrekit-alloc-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    tyrekit::tir::TyreParams::builtin()
+        .write(&dir.join("tyre.tir"))
+        .unwrap();
+    let name = CString::new("alloc").unwrap();
+    let guid = CString::new(tyrekit::fmi::GUID).unwrap();
+    let res = CString::new(format!("file://{}", dir.display())).unwrap();
+    let ok = Fmi2Status::Ok;
+    unsafe {
+        let c = fmi2Instantiate(
+            name.as_ptr(),
+            FMI2_CO_SIMULATION,
+            guid.as_ptr(),
+            res.as_ptr(),
+            std::ptr::null(),
+            0,
+            0,
+        );
+        assert!(!c.is_null());
+        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), ok);
+        assert_eq!(fmi2EnterInitializationMode(c), ok);
+        assert_eq!(fmi2ExitInitializationMode(c), ok);
+        let inputs = [vr::VX, vr::VY, vr::OMEGA, vr::FZ, vr::GAMMA];
+        let outputs = [vr::FX, vr::FY, vr::MX, vr::MY, vr::MZ, vr::KAPPA, vr::ALPHA];
+        let mut y = [0.0; 7];
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        for k in 0..1000 {
+            let u = [20.0, 0.001 * k as f64, 63.0, 4000.0, 0.0];
+            assert_eq!(
+                fmi2SetReal(c, inputs.as_ptr(), inputs.len(), u.as_ptr()),
+                ok
+            );
+            assert_eq!(fmi2DoStep(c, k as f64 * 1e-3, 1e-3, 1), ok);
+            assert_eq!(
+                fmi2GetReal(c, outputs.as_ptr(), outputs.len(), y.as_mut_ptr()),
+                ok
+            );
+        }
+        let after = ALLOCATIONS.load(Ordering::Relaxed);
+        assert!(y[1].is_finite());
+        fmi2FreeInstance(c);
+        assert_eq!(after - before, 0, "allocations in 1000 steps");
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}

@@ -216,11 +216,23 @@ pub fn segment(samples: &[Sample], o: &SegmentOptions) -> Vec<Segment> {
     let tp = |_: f64| o.p_tol;
     let tv = |x: f64| o.v_abs.max(o.v_rel * x.abs());
     let mc = min_len;
+    // Levels come from locally steady samples only, so that the ramps
+    // between set points (which pass through every value) never form one.
+    let steady = |x: &[f64], tol: &dyn Fn(f64) -> f64| -> Vec<f64> {
+        let h = w.max(3);
+        (0..x.len())
+            .filter(|&i| {
+                let (a, b) = (i.saturating_sub(h), (i + h).min(x.len() - 1));
+                (x[b] - x[a]).abs() <= 0.25 * tol(x[i])
+            })
+            .map(|i| x[i])
+            .collect()
+    };
     let (lfz, lga, lp, lv) = (
-        levels(&fz, &tfz, mc),
-        levels(&ga, &tga, mc),
-        levels(&pp, &tp, mc),
-        levels(&vv, &tv, mc),
+        levels(&steady(&fz, &tfz), &tfz, mc),
+        levels(&steady(&ga, &tga), &tga, mc),
+        levels(&steady(&pp, &tp), &tp, mc),
+        levels(&steady(&vv, &tv), &tv, mc),
     );
     if std::env::var("TK_DEBUG").is_ok() {
         eprintln!("levels fz {lfz:?}\n ga {lga:?}\n p {lp:?}\n v {lv:?} min_len {min_len} w {w}");

@@ -49,6 +49,33 @@ pub fn free_rolling_re(samples: &[Sample], re: &[f64]) -> Option<(f64, f64)> {
     fit_line(&x, &y)
 }
 
+/// Effective and loaded radius (Re, Rl) from a model evaluation, with
+/// fallbacks where the model reports none (non-finite, implausible, or
+/// exactly the unloaded radius under load): Rl = R0 − Fz/Cz and
+/// Re = R0 − Fz/(3·Cz) (Pacejka, *Tyre and Vehicle Dynamics*, 3rd ed.,
+/// §9.2.1: Re lies about a third of the deflection below R0).
+pub fn model_radii(tyre: &crate::mf::Tyre, fz: f64, re: f64, rl: f64) -> (f64, f64) {
+    let p = &tyre.params().p;
+    let r0 = p.unloaded_radius;
+    let cz = if p.vertical_stiffness > 0.0 {
+        p.vertical_stiffness
+    } else {
+        2e5
+    };
+    let defl = fz.max(0.0) / cz;
+    let rl = if rl.is_finite() && rl > 0.2 * r0 {
+        rl
+    } else {
+        r0 - defl
+    };
+    let re = if re.is_finite() && re > 0.2 * r0 && ((re - r0).abs() > 1e-12 || defl == 0.0) {
+        re
+    } else {
+        r0 - defl / 3.0
+    };
+    (re, rl)
+}
+
 /// κ for one sample given Re.
 #[inline]
 pub fn kappa(omega: f64, re: f64, vx: f64) -> f64 {
@@ -117,7 +144,8 @@ pub fn compute_kappa(
                     p: s.p,
                     omega: s.omega,
                 };
-                let r = tyre.evaluate(&inp, UseMode::default()).re;
+                let o = tyre.evaluate(&inp, UseMode::default());
+                let r = model_radii(&tyre, s.fz, o.re, o.rl).0;
                 s.kappa = kappa(s.omega, r, s.vx);
             }
             Some(format!(

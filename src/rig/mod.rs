@@ -83,29 +83,8 @@ impl SteadyMf {
     }
 }
 
-/// Radii with fallbacks when the model reports none: Rl = R0 − Fz/Cz and
-/// Re = R0 − Fz/(3 Cz) (Pacejka 3rd ed. §9.2.1: Re lies about two thirds of
-/// the deflection above Rl).
-pub fn radii(tyre: &Tyre, fz: f64, re: f64, rl: f64) -> (f64, f64) {
-    let p = &tyre.params().p;
-    let r0 = p.unloaded_radius;
-    let cz = if p.vertical_stiffness > 0.0 {
-        p.vertical_stiffness
-    } else {
-        2e5
-    };
-    let rl = if rl.is_finite() && rl > 0.2 * r0 {
-        rl
-    } else {
-        r0 - fz.max(0.0) / cz
-    };
-    let re = if re.is_finite() && re > 0.2 * r0 && (re - r0).abs() > 1e-12 {
-        re
-    } else {
-        r0 - fz.max(0.0) / (3.0 * cz)
-    };
-    (re, rl)
-}
+/// Radii with fallbacks when the model reports none (see [`crate::data::slip::model_radii`]).
+pub use crate::data::slip::model_radii as radii;
 
 impl TruthModel for SteadyMf {
     fn sample(&mut self, inp: &RigInput, _dt: f64) -> TruthOutput {

@@ -295,43 +295,78 @@ pub struct AxisSample {
     pub rl: f64,
 }
 
+/// The sign factors of one axis system, looked up once (for per-row use).
+#[derive(Clone, Copy, Debug)]
+pub struct ToIso {
+    sys: AxisSystem,
+    k: [f64; 10],
+}
+
+impl ToIso {
+    /// Factors of `sys` from [`SIGN_TABLE`].
+    pub fn new(sys: AxisSystem) -> ToIso {
+        use Quantity as Q;
+        let q = [
+            Q::Fx,
+            Q::Fy,
+            Q::Fz,
+            Q::Mx,
+            Q::My,
+            Q::Mz,
+            Q::SlipAngle,
+            Q::Inclination,
+            Q::SlipRatio,
+            Q::TurnSlip,
+        ];
+        ToIso {
+            sys,
+            k: q.map(|q| to_iso_factor(sys, q)),
+        }
+    }
+
+    /// Map one record into ISO-W (see [`to_iso`]).
+    #[inline]
+    pub fn apply(&self, r: &AxisSample) -> AxisSample {
+        let k = &self.k;
+        let mut o = AxisSample {
+            fx: k[0] * r.fx,
+            fy: k[1] * r.fy,
+            fz: k[2] * r.fz,
+            mx: k[3] * r.mx,
+            my: k[4] * r.my,
+            mz: k[5] * r.mz,
+            alpha: k[6] * r.alpha,
+            gamma: k[7] * r.gamma,
+            kappa: k[8] * r.kappa,
+            phit: k[9] * r.phit,
+            rl: r.rl,
+        };
+        if self.sys == AxisSystem::TydexC {
+            let (s, c) = o.gamma.sin_cos();
+            // C axes = W axes rotated by +γ about x: v_W = R_x(γ) v_C.
+            let rot = |y: f64, z: f64| (c * y - s * z, s * y + c * z);
+            let (fy, fz) = rot(o.fy, o.fz);
+            let (my, mz) = rot(o.my, o.mz);
+            o.fy = fy;
+            o.fz = fz;
+            o.my = my;
+            o.mz = mz;
+            // M_contact = M_centre + r × F, r = centre − contact = Rl (0, −sin γ, cos γ).
+            let (ry, rz) = (-r.rl * s, r.rl * c);
+            o.mx += ry * o.fz - rz * o.fy;
+            o.my += rz * o.fx;
+            o.mz += -ry * o.fx;
+        }
+        o
+    }
+}
+
 /// Map one record from `sys` into ISO-W. For TYDEX C the forces and moments
 /// are rotated from the wheel-fixed frame (tilted by γ about x) into W, and
 /// moments are transferred from the wheel centre to the contact point, the
 /// centre lying at `Rl·(0, −sin γ, cos γ)` from the contact point in W.
 pub fn to_iso(sys: AxisSystem, r: &AxisSample) -> AxisSample {
-    use Quantity as Q;
-    let k = |q| to_iso_factor(sys, q);
-    let mut o = AxisSample {
-        fx: k(Q::Fx) * r.fx,
-        fy: k(Q::Fy) * r.fy,
-        fz: k(Q::Fz) * r.fz,
-        mx: k(Q::Mx) * r.mx,
-        my: k(Q::My) * r.my,
-        mz: k(Q::Mz) * r.mz,
-        alpha: k(Q::SlipAngle) * r.alpha,
-        gamma: k(Q::Inclination) * r.gamma,
-        kappa: k(Q::SlipRatio) * r.kappa,
-        phit: k(Q::TurnSlip) * r.phit,
-        rl: r.rl,
-    };
-    if sys == AxisSystem::TydexC {
-        let (s, c) = o.gamma.sin_cos();
-        // C axes = W axes rotated by +γ about x: v_W = R_x(γ) v_C.
-        let rot = |y: f64, z: f64| (c * y - s * z, s * y + c * z);
-        let (fy, fz) = rot(o.fy, o.fz);
-        let (my, mz) = rot(o.my, o.mz);
-        o.fy = fy;
-        o.fz = fz;
-        o.my = my;
-        o.mz = mz;
-        // M_contact = M_centre + r × F, r = centre − contact = Rl (0, −sin γ, cos γ).
-        let (ry, rz) = (-r.rl * s, r.rl * c);
-        o.mx += ry * o.fz - rz * o.fy;
-        o.my += rz * o.fx;
-        o.mz += -ry * o.fx;
-    }
-    o
+    ToIso::new(sys).apply(r)
 }
 
 /// Inverse of [`to_iso`] (used by the writers and the rig).

@@ -20,18 +20,67 @@ fn rerr(file: &str, loc: impl Into<String>, msg: impl Into<String>) -> Error {
     }
 }
 
+/// A parse failure inside a chunk: (line index within the chunk, column, message).
+type ChunkErr = (usize, Option<usize>, String);
+
+/// Parse data lines of one chunk into columns.
+fn parse_chunk(text: &str, ncol: usize, sep: char) -> Result<Vec<Vec<f64>>, ChunkErr> {
+    let mut cols: Vec<Vec<f64>> = (0..ncol)
+        .map(|_| Vec::with_capacity(text.len() / (ncol * 10).max(1)))
+        .collect();
+    for (li, l) in text.lines().enumerate() {
+        if l.trim().is_empty() || l.starts_with('#') {
+            continue;
+        }
+        let mut k = 0;
+        for tok in l.split(sep) {
+            if k >= ncol {
+                return Err((li, None, format!("more than {ncol} fields")));
+            }
+            let tok = tok.trim();
+            let v = if tok.is_empty() {
+                f64::NAN
+            } else {
+                match tok.parse::<f64>() {
+                    Ok(v) => v,
+                    Err(_) => return Err((li, Some(k), format!("'{tok}' is not a number"))),
+                }
+            };
+            cols[k].push(v);
+            k += 1;
+        }
+        if k != ncol {
+            return Err((
+                li,
+                None,
+                format!("{k} fields, {ncol} expected (truncated line?)"),
+            ));
+        }
+    }
+    Ok(cols)
+}
+
 /// Read CSV bytes into a raw table (units from `[unit]` suffixes if present).
+/// Large files are parsed on two threads (split at a line boundary).
 pub fn read(bytes: &[u8], file: &str) -> Result<RawTable> {
     let text = std::str::from_utf8(bytes)
         .map_err(|e| rerr(file, format!("byte {}", e.valid_up_to()), "not UTF-8 text"))?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty() && !l.starts_with('#'));
-    let Some((_, head)) = lines.next() else {
+    // Header: the first non-empty, non-comment line.
+    let mut head_end = 0;
+    let mut head = "";
+    let mut head_line = 0;
+    for (i, l) in text.split_inclusive('\n').enumerate() {
+        head_end += l.len();
+        if !l.trim().is_empty() && !l.starts_with('#') {
+            head = l.trim_end_matches(['\n', '\r']);
+            head_line = i;
+            break;
+        }
+    }
+    if head.is_empty() {
         return Err(rerr(file, "line 1", "empty file: no header row"));
-    };
+    }
     let sep = if head.contains(',') {
         ','
     } else if head.contains(';') {
@@ -47,48 +96,40 @@ pub fn read(bytes: &[u8], file: &str) -> Result<RawTable> {
     if let Some(i) = names.iter().position(|n| n.is_empty()) {
         return Err(rerr(
             file,
-            "line 1",
+            format!("line {}", head_line + 1),
             format!("column {} has no name", i + 1),
         ));
     }
-    let mut cols: Vec<Vec<f64>> = (0..ncol)
-        .map(|_| Vec::with_capacity(bytes.len() / (ncol * 8).max(1)))
-        .collect();
-    for (li, l) in lines {
-        let mut k = 0;
-        for tok in l.split(sep) {
-            if k >= ncol {
-                return Err(rerr(
-                    file,
-                    format!("line {}", li + 1),
-                    format!("more than {ncol} fields"),
-                ));
-            }
-            let tok = tok.trim();
-            let v = if tok.is_empty() {
-                f64::NAN
-            } else {
-                match tok.parse::<f64>() {
-                    Ok(v) => v,
-                    Err(_) => {
-                        return Err(rerr(
-                            file,
-                            format!("line {}, column '{}'", li + 1, names[k]),
-                            format!("'{tok}' is not a number"),
-                        ))
-                    }
-                }
-            };
-            cols[k].push(v);
-            k += 1;
-        }
-        if k != ncol {
-            return Err(rerr(
-                file,
-                format!("line {}", li + 1),
-                format!("{k} fields, {ncol} expected (truncated line?)"),
-            ));
-        }
+    let body = &text[head_end..];
+    let split = if body.len() > 1 << 20 {
+        body[body.len() / 2..]
+            .find('\n')
+            .map_or(body.len(), |p| body.len() / 2 + p + 1)
+    } else {
+        body.len()
+    };
+    let (a, b) = body.split_at(split);
+    let (ra, rb) = std::thread::scope(|sc| {
+        let hb = sc.spawn(|| parse_chunk(b, ncol, sep));
+        let ra = parse_chunk(a, ncol, sep);
+        (
+            ra,
+            hb.join()
+                .unwrap_or_else(|_| Err((0, None, "parser thread failed".into()))),
+        )
+    });
+    let to_err = |(li, col, msg): ChunkErr, base: usize| {
+        let line = head_line + 2 + base + li;
+        let loc = match col {
+            Some(k) => format!("line {line}, column '{}'", names[k]),
+            None => format!("line {line}"),
+        };
+        rerr(file, loc, msg)
+    };
+    let mut cols = ra.map_err(|e| to_err(e, 0))?;
+    let cb = rb.map_err(|e| to_err(e, a.lines().count()))?;
+    for (c, mut d) in cols.iter_mut().zip(cb) {
+        c.append(&mut d);
     }
     Ok(RawTable {
         columns: names

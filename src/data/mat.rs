@@ -179,7 +179,9 @@ pub fn read(bytes: &[u8]) -> R<Vec<(String, MatValue)>> {
             )
         }
     };
-    let mut out = Vec::new();
+    // First pass: locate the top-level elements (cheap); second: decode them,
+    // the compressed ones on two threads (each variable is its own zlib stream).
+    let mut elems: Vec<(u32, usize, usize, String)> = Vec::new();
     let mut pos = 128usize;
     let mut k = 0usize;
     while pos + 8 <= bytes.len() {
@@ -201,41 +203,14 @@ pub fn read(bytes: &[u8]) -> R<Vec<(String, MatValue)>> {
                 ),
             );
         };
-        let body = &bytes[body_start..end];
-        match ty {
-            mi::COMPRESSED => {
-                let mut dec = Vec::new();
-                flate2::read::ZlibDecoder::new(body)
-                    .take(MAX_INFLATE)
-                    .read_to_end(&mut dec)
-                    .map_err(|e| MatError {
-                        location: loc.clone(),
-                        message: format!("zlib stream of a compressed variable is corrupt: {e}"),
-                    })?;
-                let (ty2, n2, hdr2, _) = tag(&dec, 0, big, &loc)?;
-                if ty2 != mi::MATRIX {
-                    return err(
-                        &loc,
-                        format!("compressed element holds data type {ty2}, expected miMATRIX (14)"),
-                    );
-                }
-                if hdr2 + n2 > dec.len() {
-                    return err(
-                        &loc,
-                        "compressed variable is shorter than its declared size (truncated)",
-                    );
-                }
-                let (name, v) = matrix(&dec[hdr2..hdr2 + n2], big, &loc)?;
-                out.push((name, v));
-                pos = end;
-            }
-            mi::MATRIX => {
-                let (name, v) = matrix(body, big, &loc)?;
-                out.push((name, v));
-                pos = end + pad8(n);
-            }
-            _ => pos = end + pad8(n),
+        if ty == mi::COMPRESSED || ty == mi::MATRIX {
+            elems.push((ty, body_start, end, loc));
         }
+        pos = if ty == mi::COMPRESSED {
+            end
+        } else {
+            end + pad8(n)
+        };
         k += 1;
     }
     if pos < bytes.len() && bytes.len() - pos < 8 && bytes[pos..].iter().any(|&b| b != 0) {
@@ -244,6 +219,58 @@ pub fn read(bytes: &[u8]) -> R<Vec<(String, MatValue)>> {
             "trailing partial element (file truncated)",
         );
     }
+    let decode = |(ty, a, b, loc): &(u32, usize, usize, String)| -> R<(String, MatValue)> {
+        let body = &bytes[*a..*b];
+        if *ty == mi::MATRIX {
+            return matrix(body, big, loc);
+        }
+        let mut dec = Vec::new();
+        flate2::read::ZlibDecoder::new(body)
+            .take(MAX_INFLATE)
+            .read_to_end(&mut dec)
+            .map_err(|e| MatError {
+                location: loc.clone(),
+                message: format!(
+                    "zlib stream of a compressed variable is corrupt or truncated: {e}"
+                ),
+            })?;
+        let (ty2, n2, hdr2, _) = tag(&dec, 0, big, loc)?;
+        if ty2 != mi::MATRIX {
+            return err(
+                loc,
+                format!("compressed element holds data type {ty2}, expected miMATRIX (14)"),
+            );
+        }
+        if hdr2 + n2 > dec.len() {
+            return err(
+                loc,
+                "compressed variable is shorter than its declared size (truncated)",
+            );
+        }
+        matrix(&dec[hdr2..hdr2 + n2], big, loc)
+    };
+    // Split the work by bytes between two threads.
+    let total: usize = elems.iter().map(|e| e.2 - e.1).sum();
+    let mut acc = 0;
+    let cut = elems
+        .iter()
+        .position(|e| {
+            acc += e.2 - e.1;
+            acc * 2 >= total
+        })
+        .map_or(elems.len(), |i| i + 1);
+    let (first, second) = elems.split_at(cut);
+    let (ra, rb) = std::thread::scope(|sc| {
+        let h = sc.spawn(|| second.iter().map(decode).collect::<R<Vec<_>>>());
+        let ra = first.iter().map(decode).collect::<R<Vec<_>>>();
+        (
+            ra,
+            h.join()
+                .unwrap_or_else(|_| err("decoder", "decoder thread failed")),
+        )
+    });
+    let mut out = ra?;
+    out.extend(rb?);
     Ok(out)
 }
 

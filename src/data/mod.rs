@@ -669,6 +669,7 @@ pub fn from_raw(raw: RawTable, format: Format, file: &str, opts: &LoadOptions) -
 
     // Build ISO-W samples.
     let alpha_raw = col(Ch::Alpha);
+    let conv = conventions::ToIso::new(axes);
     let mut samples: Vec<Sample> = Vec::with_capacity(n);
     for i in 0..n {
         let a = AxisSample {
@@ -684,7 +685,7 @@ pub fn from_raw(raw: RawTable, format: Format, file: &str, opts: &LoadOptions) -
             phit: col(Ch::Phit)[i],
             rl: rl_col.as_ref().map_or(f64::NAN, |r| r[i]),
         };
-        let w = conventions::to_iso(axes, &a);
+        let w = conv.apply(&a);
         let vx = match (get(Ch::Vx), get(Ch::Speed)) {
             (Some(v), _) => v[i],
             (None, Some(v)) => {

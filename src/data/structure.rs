@@ -82,17 +82,47 @@ fn median(v: &mut [f64]) -> f64 {
     v[m]
 }
 
-/// Running median over a centred window of `w` samples (NaN-aware).
-fn running_median(x: &[f64], w: usize) -> Vec<f64> {
+/// Piecewise-constant smoothing in O(n): every sample gets the median of its
+/// block of `b` samples (NaN-aware). Used for set-point channels, whose
+/// levels only need to be found, not tracked sample by sample.
+fn block_median(x: &[f64], b: usize) -> Vec<f64> {
+    let b = b.max(1);
+    let mut out = Vec::with_capacity(x.len());
+    let mut buf = Vec::with_capacity(b);
+    for chunk in x.chunks(b) {
+        buf.clear();
+        buf.extend(chunk.iter().copied().filter(|v| v.is_finite()));
+        let m = median(&mut buf);
+        out.extend(std::iter::repeat_n(m, chunk.len()));
+    }
+    out
+}
+
+/// Centred running mean over `w` samples in O(n) (prefix sums; NaN → skipped).
+fn running_mean(x: &[f64], w: usize) -> Vec<f64> {
     let h = w / 2;
-    let mut buf = Vec::with_capacity(w + 1);
+    let mut ps = Vec::with_capacity(x.len() + 1);
+    let mut pc = Vec::with_capacity(x.len() + 1);
+    let (mut s, mut c) = (0.0, 0usize);
+    ps.push(0.0);
+    pc.push(0);
+    for v in x {
+        if v.is_finite() {
+            s += v;
+            c += 1;
+        }
+        ps.push(s);
+        pc.push(c);
+    }
     (0..x.len())
         .map(|i| {
-            buf.clear();
-            let lo = i.saturating_sub(h);
-            let hi = (i + h + 1).min(x.len());
-            buf.extend(x[lo..hi].iter().copied().filter(|v| v.is_finite()));
-            median(&mut buf)
+            let (a, b) = (i.saturating_sub(h), (i + h + 1).min(x.len()));
+            let n = pc[b] - pc[a];
+            if n == 0 {
+                f64::NAN
+            } else {
+                (ps[b] - ps[a]) / n as f64
+            }
         })
         .collect()
 }
@@ -205,7 +235,7 @@ pub fn segment(samples: &[Sample], o: &SegmentOptions) -> Vec<Segment> {
     let gap = (o.gap_factor * dt).max(1.0);
 
     let ch = |f: &dyn Fn(&Sample) -> f64| -> Vec<f64> {
-        running_median(&samples.iter().map(f).collect::<Vec<_>>(), w)
+        block_median(&samples.iter().map(f).collect::<Vec<_>>(), w)
     };
     let fz = ch(&|s| s.fz);
     let ga = ch(&|s| s.gamma);
@@ -300,7 +330,7 @@ fn split_by_alpha_setpoint(
 ) {
     let al: Vec<f64> = s[a..b].iter().map(|x| x.alpha).collect();
     let w = (min_len / 4).max(1) | 1;
-    let am = running_median(&al, w);
+    let am = block_median(&al, w);
     let ta = |_: f64| o.alpha_tol;
     let lv = levels(&am, &ta, min_len);
     // α is a set point only if nearly all samples sit on levels.
@@ -468,7 +498,7 @@ pub fn sweep_and_time(s: &[Sample], segs: &[Segment]) -> (Vec<i8>, Vec<f64>) {
             dts.iter().sum::<f64>() / dts.len() as f64
         };
         let h = ((0.1 / dt.max(1e-6)).round() as usize).max(1);
-        let xs = running_median(&x, 2 * h + 1);
+        let xs = running_mean(&x, 2 * h + 1);
         let mut last = 0i8;
         for i in 0..seg.len() {
             let (a, b) = (i.saturating_sub(h), (i + h).min(seg.len() - 1));

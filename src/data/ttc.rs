@@ -77,14 +77,14 @@ pub fn read_mat(bytes: &[u8], file: &str) -> Result<RawTable> {
         .unwrap_or_default();
     let mut rows: Option<usize> = None;
     let mut unsupported = Vec::new();
-    for (name, v) in &vars {
+    for (name, v) in vars {
         match v {
             MatValue::Numeric { dims, data }
                 if dims.iter().filter(|&&d| d > 1).count() <= 1 && data.len() > 1 =>
             {
                 let unit = units
                     .iter()
-                    .find(|(n, _)| n.eq_ignore_ascii_case(name))
+                    .find(|(n, _)| n.eq_ignore_ascii_case(&name))
                     .map(|(_, u)| u.clone());
                 match rows {
                     None => rows = Some(data.len()),
@@ -97,14 +97,10 @@ pub fn read_mat(bytes: &[u8], file: &str) -> Result<RawTable> {
                     }
                     _ => {}
                 }
-                t.columns.push(RawColumn {
-                    name: name.clone(),
-                    unit,
-                    data: data.clone(),
-                });
+                t.columns.push(RawColumn { name, unit, data });
             }
             MatValue::Numeric { .. } => {}
-            MatValue::Char { text, .. } => t.meta.push((name.clone(), text.clone())),
+            MatValue::Char { text, .. } => t.meta.push((name, text)),
             MatValue::Unsupported { class } => unsupported.push(format!("'{name}' ({class})")),
             _ => {}
         }

@@ -526,11 +526,17 @@ fn extra_dim(name: &str) -> Option<Dim> {
             Some(Dim::Length)
         }
         "sr" | "sl" | "nfx" | "nfy" => Some(Dim::Ratio),
+        "rst" | "ambtmp" => Some(Dim::Temperature),
         _ if n.starts_with("tst") || n.contains("tmp") || n.contains("temp") => {
             Some(Dim::Temperature)
         }
         _ => None,
     }
+}
+
+/// SI unit this crate stores an extra channel in ("-" when unknown).
+pub fn extra_si_unit(name: &str) -> &'static str {
+    extra_dim(name).map_or("-", |d| d.si())
 }
 
 /// Canonical extra name: radii as `Rl`/`Re`, the rest as written.
@@ -603,6 +609,9 @@ pub fn from_raw(raw: RawTable, format: Format, file: &str, opts: &LoadOptions) -
                     "column '{}' duplicates an earlier {ch:?} column: kept as extra",
                     col.name
                 ));
+                report
+                    .extra_units
+                    .push((name.clone(), unit.clone().unwrap_or_default()));
                 extra.push((name.clone(), col.data[..n].to_vec()));
                 continue;
             }

@@ -551,7 +551,12 @@ pub fn apply(
                 for (_, v) in rec.extra.iter_mut() {
                     v.drain(..k.min(v.len()));
                 }
-                segs = segment(&rec.samples, o);
+                // Shift the segments instead of segmenting again.
+                segs.retain(|g| g.end > k + 1);
+                for g in segs.iter_mut() {
+                    g.start = g.start.max(k) - k;
+                    g.end -= k;
+                }
             }
         }
     }

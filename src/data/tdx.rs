@@ -209,7 +209,12 @@ pub fn write(rec: &Recording) -> String {
             .filter(|c| c.is_ascii_alphanumeric() || *c == '_')
             .take(10)
             .collect();
-        let _ = writeln!(s, "{name:<10}{:<30}{:<10}1 0 0", "extra channel", "-");
+        let _ = writeln!(
+            s,
+            "{name:<10}{:<30}{:<10}1 0 0",
+            "extra channel",
+            super::extra_si_unit(n)
+        );
     }
     let _ = writeln!(s, "**MEASURDATA");
     for (i, smp) in rec.samples.iter().enumerate() {

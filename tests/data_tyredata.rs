@@ -97,7 +97,7 @@ fn tyredata_has_45_sweeps_3_pressures_3_cambers_5_loads() {
     // Sweeps are triangular 0 → −13° → +13° → 0: both directions occur in each.
     for s in segs {
         let d = &rec.sweep_dir[s.start..s.end];
-        assert!(d.iter().any(|x| *x == 1) && d.iter().any(|x| *x == -1));
+        assert!(d.contains(&1) && d.contains(&-1));
         assert_eq!(rec.t_in_segment[s.start], 0.0);
     }
 }

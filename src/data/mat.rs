@@ -477,7 +477,7 @@ fn matrix(body: &[u8], big: bool, loc: &str) -> R<(String, MatValue)> {
             let (ty, d) = s.next("characters")?;
             let chars = to_text(ty, d, big, &loc)?;
             let rows = dims.first().copied().unwrap_or(0).max(1);
-            let cols = if rows == 0 { 0 } else { chars.len() / rows };
+            let cols = chars.len().checked_div(rows).unwrap_or(0);
             // Column-major: character (r, c) is at c*rows + r.
             let mut lines = Vec::with_capacity(rows);
             for r in 0..rows {

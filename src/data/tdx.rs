@@ -112,7 +112,7 @@ pub fn read(bytes: &[u8], file: &str) -> Result<RawTable> {
                     ));
                 }
             }
-            other => t.meta.push((format!("{other}"), l.trim().to_string())),
+            other => t.meta.push((other.to_string(), l.trim().to_string())),
         }
     }
     if chans.is_empty() {

@@ -124,9 +124,7 @@ pub fn read_mat(bytes: &[u8], file: &str) -> Result<RawTable> {
 }
 
 fn is_numeric_line(l: &str) -> bool {
-    let mut toks = l
-        .split(|c: char| c == '\t' || c == ',' || c == ' ')
-        .filter(|s| !s.is_empty());
+    let mut toks = l.split(['\t', ',', ' ']).filter(|s| !s.is_empty());
     match toks.next() {
         Some(t) => {
             t.parse::<f64>().is_ok()

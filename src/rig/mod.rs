@@ -495,7 +495,7 @@ pub fn simulate(cfg: &RigConfig, model: &mut dyn TruthModel) -> RigRun {
         (
             1.0 / 0.447_04,
             1.0 / 0.0254,
-            1.0 / 6894.757_293,
+            1.0 / 6_894.757_293,
             1.0 / 4.448_221_615_260_5,
             1.0 / 1.355_817_948_331_4,
         )
@@ -582,7 +582,7 @@ pub fn simulate(cfg: &RigConfig, model: &mut dyn TruthModel) -> RigRun {
                 last_re = out.re;
             }
             last_t = t;
-            if k % dec == 0 {
+            if k.is_multiple_of(dec) {
                 let f = out.forces;
                 let iso = AxisSample {
                     fx: f.fx + nz.fx_offset + nz.fx * gauss(&mut rng),

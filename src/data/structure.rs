@@ -248,9 +248,14 @@ pub fn segment(samples: &[Sample], o: &SegmentOptions) -> Vec<Segment> {
     let mc = min_len;
     // Levels come from locally steady samples only, so that the ramps
     // between set points (which pass through every value) never form one.
+    // Long recordings are thinned (every `stride`-th sample, min count scaled
+    // alike) so that finding levels costs a sort of at most ~10^5 values.
+    let stride = (n / 100_000).max(1);
+    let mcs = (mc / stride).max(2);
     let steady = |x: &[f64], tol: &dyn Fn(f64) -> f64| -> Vec<f64> {
         let h = w.max(3);
         (0..x.len())
+            .step_by(stride)
             .filter(|&i| {
                 let (a, b) = (i.saturating_sub(h), (i + h).min(x.len() - 1));
                 (x[b] - x[a]).abs() <= 0.25 * tol(x[i])
@@ -259,14 +264,11 @@ pub fn segment(samples: &[Sample], o: &SegmentOptions) -> Vec<Segment> {
             .collect()
     };
     let (lfz, lga, lp, lv) = (
-        levels(&steady(&fz, &tfz), &tfz, mc),
-        levels(&steady(&ga, &tga), &tga, mc),
-        levels(&steady(&pp, &tp), &tp, mc),
-        levels(&steady(&vv, &tv), &tv, mc),
+        levels(&steady(&fz, &tfz), &tfz, mcs),
+        levels(&steady(&ga, &tga), &tga, mcs),
+        levels(&steady(&pp, &tp), &tp, mcs),
+        levels(&steady(&vv, &tv), &tv, mcs),
     );
-    if std::env::var("TK_DEBUG").is_ok() {
-        eprintln!("levels fz {lfz:?}\n ga {lga:?}\n p {lp:?}\n v {lv:?} min_len {min_len} w {w}");
-    }
     // Per-sample key (None = transition).
     let keys: Vec<Option<[u16; 4]>> = (0..n)
         .map(|i| {

@@ -350,3 +350,31 @@ fn rig_is_reproducible_and_noise_free_run_is_exact() {
     assert_eq!(l.recording.segments.len(), 45);
     let _ = std::fs::remove_file(&p);
 }
+
+#[test]
+fn warmup_at_its_own_load_is_cut_as_an_irregular_segment() {
+    let tyre = Tyre::builtin();
+    let mut cfg = RigConfig::standard(&tyre, 21);
+    if let Some(w) = cfg.programme.warmup.as_mut() {
+        w.fz = Some(1200.0);
+    }
+    cfg.decimate = 2;
+    let r = simulate(&cfg, &mut SteadyMf::new(tyre));
+    let p = tmp("warm.mat");
+    r.write_mat(&p, true).unwrap();
+    let l = read(&p, ReChoice::FreeRolling);
+    let w = l.report.warmup.as_ref().expect("warm-up detected");
+    let t_prog = r.truth[r.warmup_rows].time;
+    // The programme begins with the 1.5 s load transition from the warm-up
+    // load; the cut must fall between its start and the first sweep.
+    let t_sweep = r.truth[r.plan[0].start].time;
+    assert!(
+        w.t_end <= t_sweep + 1e-9 && w.t_end >= t_prog - 1e-9,
+        "cut at {} s, programme at {t_prog} s, first sweep at {t_sweep} s: {}",
+        w.t_end,
+        w.reason
+    );
+    assert!(w.reason.contains("unlike the programme"), "{}", w.reason);
+    assert_eq!(l.recording.segments.len(), r.plan.len());
+    let _ = std::fs::remove_file(&p);
+}

@@ -13,8 +13,9 @@
 //! 3. Kind from the swept ranges: α swept and κ ≈ const → pure lateral;
 //!    κ swept at α ≈ 0 → pure longitudinal; κ swept at α ≠ 0 or both
 //!    swept → combined.
-//! 4. Warm-up: leading segments whose sweep signature (slip range, duration)
-//!    does not match the programme's typical segment of the same kind are cut;
+//! 4. Warm-up: leading segments whose sweep signature (slip range within
+//!    15 %, duration at least half) does not match the programme's typical
+//!    segment of the same kind, or whose load no other segment uses, are cut;
 //!    if the first programme segment is longer than the typical one by more
 //!    than half, its surplus beginning (extra sweeps at the same set point) is
 //!    cut too. What was cut is reported.
@@ -441,7 +442,12 @@ pub fn detect_warmup(s: &[Sample], segs: &[Segment]) -> Option<(usize, String)> 
         };
         let (l, h, d) = signature(s, g);
         let range = (hi - lo).abs().max(1e-9);
-        let off = (l - lo).abs() > 0.25 * range || (h - hi).abs() > 0.25 * range || d < 0.5 * dur;
+        // A load no other segment runs at is not part of the matrix either.
+        let lone = !segs
+            .iter()
+            .any(|o| !std::ptr::eq(o, g) && (o.fz - g.fz).abs() <= 0.08 * g.fz.abs().max(750.0));
+        let off =
+            (l - lo).abs() > 0.15 * range || (h - hi).abs() > 0.15 * range || d < 0.5 * dur || lone;
         if !off {
             // Conforming segment: cut its surplus beginning if much longer.
             if d > 1.5 * dur && dur > 0.0 {

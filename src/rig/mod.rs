@@ -114,6 +114,9 @@ impl TruthModel for SteadyMf {
 pub struct Warmup {
     pub points: Vec<f64>,
     pub rate: f64,
+    /// Load of the warm-up (N); None: the programme's first load (the
+    /// warm-up then runs straight into the first segment at the same set point).
+    pub fz: Option<f64>,
 }
 
 /// A test programme (ISO-W, SI). [`Programme::standard`] gives the TTC-like one.
@@ -176,6 +179,7 @@ impl Programme {
                     .map(|x| d(*x))
                     .collect(),
                 rate: d(3.0),
+                fz: None,
             }),
         }
     }
@@ -417,10 +421,14 @@ pub fn simulate(cfg: &RigConfig, model: &mut dyn TruthModel) -> RigRun {
         to: cur,
         dur: 1.0,
     });
-    goto(&mut steps, &mut cur, first, 2.0);
+    let wsp = SetPoint {
+        fz: pr.warmup.as_ref().and_then(|w| w.fz).unwrap_or(first.fz),
+        ..first
+    };
+    goto(&mut steps, &mut cur, wsp, 2.0);
     if let Some(w) = &pr.warmup {
         steps.push(Step::Lateral {
-            sp: first,
+            sp: wsp,
             points: w.points.clone(),
             rate: w.rate,
             warmup: true,

@@ -8,10 +8,14 @@ use std::path::PathBuf;
 use tyrekit::data::{load, LoadOptions, SegmentKind};
 
 fn data_file() -> Option<PathBuf> {
+    shared_file("TyreData.csv")
+}
+
+fn shared_file(name: &str) -> Option<PathBuf> {
     // ../shared relative to the crate root (CI layout); TYREKIT_SHARED overrides.
     let shared = std::env::var("TYREKIT_SHARED")
         .unwrap_or_else(|_| concat!(env!("CARGO_MANIFEST_DIR"), "/../shared").into());
-    let p = PathBuf::from(shared).join("data/measurements/TyreData.csv");
+    let p = PathBuf::from(shared).join("data/measurements").join(name);
     if p.exists() {
         Some(p)
     } else {
@@ -99,5 +103,29 @@ fn tyredata_has_45_sweeps_3_pressures_3_cambers_5_loads() {
         let d = &rec.sweep_dir[s.start..s.end];
         assert!(d.contains(&1) && d.contains(&-1));
         assert_eq!(rec.t_in_segment[s.start], 0.0);
+    }
+}
+
+/// The same data as a MATLAB `table` object (MCOS): not decodable as
+/// channels, and said so clearly instead of misread.
+#[test]
+fn tyredata_mat_table_object_is_refused_clearly() {
+    let Some(p) = shared_file("TyreData.mat") else {
+        return;
+    };
+    match load(&p, &LoadOptions::default()) {
+        Err(tyrekit::Error::Recording {
+            location, message, ..
+        }) => {
+            assert_eq!(location, "variables");
+            assert!(
+                message.contains("'TyreData'") && message.contains("table"),
+                "{message}"
+            );
+        }
+        other => panic!(
+            "expected a clear refusal, got {:?}",
+            other.map(|l| l.report)
+        ),
     }
 }

@@ -78,6 +78,10 @@ pub fn read_mat(bytes: &[u8], file: &str) -> Result<RawTable> {
     let mut rows: Option<usize> = None;
     let mut unsupported = Vec::new();
     for (name, v) in vars {
+        // MATLAB's own subsystem data (unnamed, or `__function_workspace__`) is not a channel.
+        if name.is_empty() || name.starts_with("__") {
+            continue;
+        }
         match v {
             MatValue::Numeric { dims, data }
                 if dims.iter().filter(|&&d| d > 1).count() <= 1 && data.len() > 1 =>
@@ -199,6 +203,7 @@ pub fn read_dat(bytes: &[u8], file: &str) -> Result<RawTable> {
             continue;
         }
         let mut k = 0;
+        let l = l.trim_end();
         let toks: Box<dyn Iterator<Item = &str>> = if tab {
             Box::new(l.split('\t'))
         } else {

@@ -52,7 +52,33 @@ pub struct TruthOutput {
 
 /// A truth model: the physics the rig "measures". Implementations may hold
 /// states (lags, temperatures); `dt` is the time since the previous call
-/// (0 on the first call after [`TruthModel::reset`]).
+/// (0 on the first call after [`TruthModel::reset`]). The rig calls
+/// [`TruthModel::sample`] exactly once per simulated sample, in time order,
+/// also while the tyre is unloaded between runs (Fz = 0).
+///
+/// A concealed effect is a wrapper around another model, e.g. a first-order
+/// slip-angle lag with relaxation length σ (Pacejka 3rd ed. eq. 7.11):
+///
+/// ```
+/// use tyrekit::rig::{RigInput, SteadyMf, TruthModel, TruthOutput};
+/// struct Lagged<M: TruthModel> { inner: M, sigma: f64, alpha: f64 }
+/// impl<M: TruthModel> TruthModel for Lagged<M> {
+///     fn sample(&mut self, inp: &RigInput, dt: f64) -> TruthOutput {
+///         let travel = inp.mf.vx.abs() * dt;
+///         self.alpha += (inp.mf.alpha - self.alpha) * (1.0 - (-travel / self.sigma).exp());
+///         let mut lagged = *inp;
+///         lagged.mf.alpha = self.alpha;
+///         self.inner.sample(&lagged, dt)
+///     }
+///     fn reset(&mut self) { self.alpha = 0.0; self.inner.reset() }
+///     fn describe(&self) -> String { format!("{} + relaxation σ = {} m", self.inner.describe(), self.sigma) }
+/// }
+/// let mut m = Lagged { inner: SteadyMf::new(tyrekit::mf::Tyre::builtin()), sigma: 0.3, alpha: 0.0 };
+/// let mut cfg = tyrekit::rig::RigConfig::standard(&tyrekit::mf::Tyre::builtin(), 1);
+/// cfg.programme.pressures.truncate(1);
+/// let run = tyrekit::rig::simulate(&cfg, &mut m);
+/// assert_eq!(run.plan.len(), 30);
+/// ```
 pub trait TruthModel {
     /// Forces and radii for the imposed inputs.
     fn sample(&mut self, inp: &RigInput, dt: f64) -> TruthOutput;

@@ -476,6 +476,16 @@ fn matrix(body: &[u8], big: bool, loc: &str) -> R<(String, MatValue)> {
         mx::CHAR => {
             let (ty, d) = s.next("characters")?;
             let chars = to_text(ty, d, big, &loc)?;
+            if chars.len() != count {
+                return err(
+                    &loc,
+                    format!(
+                        "{} characters stored for dimensions {}",
+                        chars.len(),
+                        dims_str(&dims)
+                    ),
+                );
+            }
             let rows = dims.first().copied().unwrap_or(0).max(1);
             let cols = chars.len().checked_div(rows).unwrap_or(0);
             // Column-major: character (r, c) is at c*rows + r.
@@ -488,6 +498,16 @@ fn matrix(body: &[u8], big: bool, loc: &str) -> R<(String, MatValue)> {
                 dims,
                 text: lines.join("\n"),
             }
+        }
+        mx::STRUCT | mx::OBJECT | mx::CELL if count > body.len().max(1 << 16) => {
+            return err(
+                &loc,
+                format!(
+                    "implausible dimensions {} for a {}-byte array",
+                    dims_str(&dims),
+                    body.len()
+                ),
+            );
         }
         mx::STRUCT | mx::OBJECT => {
             if class == mx::OBJECT {
@@ -739,6 +759,21 @@ mod tests {
                     "cut at {cut} of {} (compress {compress}) accepted",
                     bytes.len()
                 );
+            }
+        }
+        // Every truncation point and single-byte corruption: an error or a
+        // value, never a panic or a huge allocation.
+        for compress in [false, true] {
+            let bytes = write(&sample_vars(), compress, "t");
+            for cut in 0..bytes.len() {
+                let _ = read(&bytes[..cut]);
+            }
+            for i in 128..bytes.len() {
+                for x in [0x00u8, 0xff, 0x7f] {
+                    let mut b = bytes.clone();
+                    b[i] ^= x.max(1);
+                    let _ = read(&b);
+                }
             }
         }
         // Garbage after a valid header must not panic either.

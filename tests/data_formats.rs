@@ -50,19 +50,19 @@ fn same_samples(a: &[tyrekit::data::Sample], b: &[tyrekit::data::Sample]) {
     }
 }
 
-fn rig_loaded() -> Loaded {
+fn rig_loaded(name: &str) -> Loaded {
     let tyre = Tyre::builtin();
     let mut cfg = RigConfig::standard(&tyre, 2);
     cfg.decimate = 5;
     cfg.programme.pressures.truncate(1);
     let r = simulate(&cfg, &mut SteadyMf::new(tyre));
-    let p = tmp("small.mat", &tyrekit::data::ttc::write_mat(&r.table, true));
+    let p = tmp(name, &tyrekit::data::ttc::write_mat(&r.table, true));
     load(&p, &LoadOptions::default()).unwrap()
 }
 
 #[test]
 fn csv_and_tydex_round_trip_the_clean_table() {
-    let l = rig_loaded();
+    let l = rig_loaded("small-rt.mat");
     let rec = &l.recording;
     let csv = csvio::write(rec);
     let head = csv.lines().next().unwrap();
@@ -170,8 +170,6 @@ fn malformed_files_name_the_place() {
     let t = "**HEADER\n**MEASURCHANNELS\nRUNTIME time s 1 0 0\nFZW load N 1 0 0\n**MEASURDATA\n0 1000\n0.1\n**END\n";
     expect_recording_error(load_str("row.tdx", t), "line 7");
     // MAT: a valid file cut short.
-    let l = rig_loaded();
-    let _ = l;
     let tyre = Tyre::builtin();
     let mut cfg = RigConfig::standard(&tyre, 9);
     cfg.decimate = 50;

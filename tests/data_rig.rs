@@ -378,3 +378,56 @@ fn warmup_at_its_own_load_is_cut_as_an_irregular_segment() {
     assert_eq!(l.recording.segments.len(), r.plan.len());
     let _ = std::fs::remove_file(&p);
 }
+
+/// Other tyres, more noise, another sample rate: the structure is still found.
+#[test]
+fn structure_survives_other_tyres_noise_and_rates() {
+    let shared = std::env::var("TYREKIT_SHARED")
+        .unwrap_or_else(|_| concat!(env!("CARGO_MANIFEST_DIR"), "/../shared").into());
+    let mut tyres = vec![("builtin".to_string(), Tyre::builtin())];
+    for f in ["FSAE_Defaults.tir", "CityBus_Pac02Tire.tir"] {
+        let p = PathBuf::from(&shared).join("data/tir").join(f);
+        match Tyre::from_file(&p) {
+            Ok(t) => tyres.push((f.to_string(), t)),
+            Err(_) => println!("SKIP {f}: not readable ({})", p.display()),
+        }
+    }
+    for (name, tyre) in tyres {
+        let mut cfg = RigConfig::standard(&tyre, 13);
+        cfg.sample_rate = 50.0;
+        let n = &mut cfg.noise;
+        // Twice the default sensor noise and load wander (σ 30 N, the upper
+        // end of the 17–35 N seen in the real TyreData.csv).
+        for x in [
+            &mut n.fx,
+            &mut n.fy,
+            &mut n.fz,
+            &mut n.mz,
+            &mut n.mx,
+            &mut n.alpha,
+            &mut n.p,
+            &mut n.v,
+            &mut n.fz_wander,
+        ] {
+            *x *= 2.0;
+        }
+        let r = simulate(&cfg, &mut SteadyMf::new(tyre));
+        let p = tmp(&format!("robust-{name}.mat"));
+        r.write_mat(&p, true).unwrap();
+        let l = read(&p, ReChoice::FreeRolling);
+        assert_eq!(l.recording.segments.len(), r.plan.len(), "{name}");
+        for (g, q) in l.recording.segments.iter().zip(&r.plan) {
+            assert_eq!(g.kind, q.kind, "{name}");
+            // The median of a 16 s run of wander with σ 30 N and τ 1 s has
+            // σ ≈ 30/√8 ≈ 11 N; 40 N is about 4σ.
+            assert!(
+                (g.fz - q.fz).abs() < 40.0,
+                "{name}: Fz {} vs {}",
+                g.fz,
+                q.fz
+            );
+        }
+        assert!(l.report.warmup.is_some(), "{name}");
+        let _ = std::fs::remove_file(&p);
+    }
+}

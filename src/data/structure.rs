@@ -155,18 +155,41 @@ fn levels(x: &[f64], tol: &dyn Fn(f64) -> f64, min_count: usize) -> Vec<f64> {
             k += 1;
             continue;
         }
-        let (a, mut b) = bins[k];
+        let first = k;
         k += 1;
         // Adjacent in value (not just in sorted order): the next bin begins
         // within half a tolerance of this one's last value.
         while k < bins.len()
             && bins[k].1 - bins[k].0 >= min_count
-            && v[bins[k].0] - v[b - 1] <= 0.5 * tol(v[b - 1])
+            && v[bins[k].0] - v[bins[k - 1].1 - 1] <= 0.5 * tol(v[bins[k - 1].1 - 1])
         {
-            b = bins[k].1;
             k += 1;
         }
-        out.push(v[(a + b) / 2]);
+        // A chain may hold two levels whose noise overlaps: split it at
+        // valleys deeper than a third of the lower neighbouring peak.
+        let mut parts = vec![(first, k)];
+        let mut done = Vec::new();
+        while let Some((a, b)) = parts.pop() {
+            let cnt = |i: usize| bins[i].1 - bins[i].0;
+            let split = (a + 1..b.saturating_sub(1))
+                .min_by_key(|&i| cnt(i))
+                .filter(|&m| {
+                    let left = (a..m).map(cnt).max().unwrap_or(0);
+                    let right = (m + 1..b).map(cnt).max().unwrap_or(0);
+                    3 * cnt(m) < left.min(right)
+                });
+            match split {
+                Some(m) => {
+                    parts.push((a, m));
+                    parts.push((m + 1, b));
+                }
+                None => done.push((a, b)),
+            }
+        }
+        done.sort();
+        for (a, b) in done {
+            out.push(v[(bins[a].0 + bins[b - 1].1) / 2]);
+        }
     }
     // Merge levels closer than their tolerance.
     let mut merged: Vec<f64> = Vec::new();
@@ -183,14 +206,18 @@ fn assign(x: f64, lv: &[f64], tol: &dyn Fn(f64) -> f64) -> Option<u16> {
     if !x.is_finite() {
         return if lv.is_empty() { Some(u16::MAX) } else { None };
     }
-    let mut best: Option<(u16, f64)> = None;
-    for (k, &l) in lv.iter().enumerate() {
-        let d = (x - l).abs();
-        if d <= tol(l) && best.is_none_or(|(_, bd)| d < bd) {
-            best = Some((k as u16, d));
-        }
-    }
-    best.map(|b| b.0)
+    // Nearest level, if within its tolerance — widened up to 3× where the
+    // neighbouring levels leave room (half the gap), so that slow set-point
+    // wander does not break a segment.
+    let k = (0..lv.len()).min_by(|&a, &b| (x - lv[a]).abs().total_cmp(&(x - lv[b]).abs()))?;
+    let l = lv[k];
+    let gap = |j: Option<usize>| {
+        j.and_then(|j| lv.get(j))
+            .map_or(f64::INFINITY, |n| (n - l).abs())
+    };
+    let room = 0.5 * gap(k.checked_sub(1)).min(gap(Some(k + 1)));
+    let lim = tol(l).max(room.min(3.0 * tol(l)));
+    ((x - l).abs() <= lim).then_some(k as u16)
 }
 
 /// Robust spread: 98th − 2nd percentile.
@@ -339,30 +366,39 @@ fn split_by_alpha_setpoint(
     // α is a set point only if nearly all samples sit on levels.
     let on = am
         .iter()
-        .filter(|x| assign(**x, &lv, &ta).is_some())
+        .filter(|x| strict_assign(**x, &lv, o.alpha_tol).is_some())
         .count();
     let kappa_swept = spread(s[a..b].iter().map(|x| x.kappa)) > 0.03
         || spread(s[a..b].iter().map(|x| x.fx / x.fz.max(1.0))) > 0.3
             && spread(al.iter().copied()) < 2f64.to_radians();
-    if lv.len() > 1 && kappa_swept && on as f64 > 0.9 * (b - a) as f64 {
-        let mut start = a;
-        let mut cur = assign(am[0], &lv, &ta);
-        for i in a + 1..b {
-            let k = assign(am[i - a], &lv, &ta);
-            if k.is_some() && k != cur {
-                if i - start >= min_len {
-                    out.push(make_segment(s, start, i, o));
-                }
-                start = i;
-                cur = k;
+    if !lv.is_empty() && kappa_swept && on as f64 > 0.8 * (b - a) as f64 {
+        // Runs of one α set point (strict tolerance); samples off every set
+        // point (α ramping between them) belong to no segment.
+        let key = |i: usize| strict_assign(am[i - a], &lv, o.alpha_tol);
+        let mut i = a;
+        while i < b {
+            let Some(k) = key(i) else {
+                i += 1;
+                continue;
+            };
+            let mut j = i + 1;
+            while j < b && key(j) == Some(k) {
+                j += 1;
             }
-        }
-        if b - start >= min_len {
-            out.push(make_segment(s, start, b, o));
+            if j - i >= min_len {
+                out.push(make_segment(s, i, j, o));
+            }
+            i = j;
         }
     } else {
         out.push(make_segment(s, a, b, o));
     }
+}
+
+/// Nearest level within exactly `tol`.
+fn strict_assign(x: f64, lv: &[f64], tol: f64) -> Option<u16> {
+    let k = (0..lv.len()).min_by(|&a, &b| (x - lv[a]).abs().total_cmp(&(x - lv[b]).abs()))?;
+    ((x - lv[k]).abs() <= tol).then_some(k as u16)
 }
 
 fn make_segment(s: &[Sample], a: usize, b: usize, o: &SegmentOptions) -> Segment {

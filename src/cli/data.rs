@@ -134,15 +134,18 @@ pub fn run(cmd: Command) -> Result<()> {
                 if json {
                     all.push(summary_json(&l));
                 } else {
-                    print!("{}", summary_text(&l));
+                    print_out(&summary_text(&l));
                 }
             }
             if json {
-                println!("{}", serde_json::to_string_pretty(&all).unwrap_or_default());
+                print_out(&format!(
+                    "{}\n",
+                    serde_json::to_string_pretty(&all).unwrap_or_default()
+                ));
             }
             if signs {
-                println!("\nSign factors mapping recorded values onto ISO-W (iso = factor · recorded):\n");
-                print!("{}", data::conventions::sign_table_markdown());
+                print_out("\nSign factors mapping recorded values onto ISO-W (iso = factor · recorded):\n\n");
+                print_out(&data::conventions::sign_table_markdown());
             }
             Ok(())
         }
@@ -177,11 +180,17 @@ pub fn run(cmd: Command) -> Result<()> {
             let l = data::load(&file, &read.options()?)?;
             let files = data::plot::plot_recording(&l.recording, &out)?;
             for f in files {
-                println!("{}", f.display());
+                print_out(&format!("{}\n", f.display()));
             }
             Ok(())
         }
     }
+}
+
+/// Print to stdout; a closed pipe (`… | head`) is not an error worth a panic.
+fn print_out(text: &str) {
+    use std::io::Write;
+    let _ = std::io::stdout().lock().write_all(text.as_bytes());
 }
 
 fn fmt_range(lo: f64, hi: f64, scale: f64, prec: usize) -> String {

@@ -185,6 +185,12 @@ impl Recording {
     pub fn from_file(path: &Path) -> Result<Recording> {
         Ok(load(path, &LoadOptions::default())?.recording)
     }
+    /// The samples of segment `k` (empty when out of range).
+    pub fn segment_samples(&self, k: usize) -> &[Sample] {
+        self.segments.get(k).map_or(&[][..], |g| {
+            &self.samples[g.start.min(self.samples.len())..g.end.min(self.samples.len())]
+        })
+    }
     /// Index of the segment holding sample `i`.
     pub fn segment_of(&self, i: usize) -> Option<usize> {
         let k = self.segments.partition_point(|s| s.end <= i);

@@ -3,6 +3,7 @@
 //! One file per area; `tyrekit bench [AREA…]` runs them.
 //! Must never: be used as a pass/fail test (timings are reported, not asserted).
 
+pub mod data;
 pub mod diagnose;
 pub mod fit;
 pub mod fmu;
@@ -28,4 +29,5 @@ pub const SECTIONS: &[Section] = &[
     ("transient", transient::run),
     ("fit", fit::run),
     ("diagnose", diagnose::run),
+    ("data", data::run),
 ];

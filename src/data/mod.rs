@@ -2,10 +2,29 @@
 //! axis-system and unit conversion into ISO-W SI, warm-up removal, slip
 //! computation and the split into test conditions.
 //!
+//! Pipeline ([`load`]): file → [`RawTable`] (names, units, columns as stored)
+//! → channel identification (aliases) → units to SI ([`units`]) → signs to
+//! ISO-W ([`conventions`]) → rows with NaN / out-of-range core values dropped
+//! and counted → κ from wheel speed ([`slip`]) → warm-up cut and segments
+//! ([`structure`]).
+//!
 //! Must never: keep a NaN or out-of-range row silently (drop and count it),
 //! guess units a file states, or panic on a malformed file.
-//!
-//! STUB: the types below are the contract `fit` and `diagnose` build on.
+
+pub mod conventions;
+pub mod csvio;
+pub mod mat;
+pub mod plot;
+pub mod slip;
+pub mod structure;
+pub mod tdx;
+pub mod ttc;
+pub mod units;
+
+use crate::error::{Error, Result};
+use conventions::{AxisSample, AxisSystem};
+use std::path::Path;
+use units::Dim;
 
 /// One sample of a recording, ISO-W axes, SI units. Channels the recording
 /// lacks are NaN (see [`Recording::has`]).
@@ -13,7 +32,7 @@
 pub struct Sample {
     /// Time (s).
     pub time: f64,
-    /// Longitudinal speed (m/s).
+    /// Longitudinal speed of the wheel centre (m/s): V·cos α for rigs that record the road speed V.
     pub vx: f64,
     /// Wheel spin (rad/s).
     pub omega: f64,
@@ -45,6 +64,18 @@ pub enum SegmentKind {
     Other,
 }
 
+impl SegmentKind {
+    /// Short label for tables.
+    pub fn label(self) -> &'static str {
+        match self {
+            SegmentKind::PureLateral => "lateral",
+            SegmentKind::PureLongitudinal => "longitudinal",
+            SegmentKind::Combined => "combined",
+            SegmentKind::Other => "other",
+        }
+    }
+}
+
 /// A run of samples at one set of test conditions.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Segment {
@@ -61,6 +92,17 @@ pub struct Segment {
     pub alpha: f64,
 }
 
+impl Segment {
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.end - self.start
+    }
+    /// Whether the segment holds no sample.
+    pub fn is_empty(&self) -> bool {
+        self.end <= self.start
+    }
+}
+
 /// A recording converted to ISO-W SI, with its test structure.
 #[derive(Clone, Debug, Default)]
 pub struct Recording {
@@ -71,13 +113,57 @@ pub struct Recording {
     /// Names of the [`Sample`] channels the recording actually has (e.g. "Fx", "Mz").
     pub channels: Vec<String>,
     /// Further channels (temperatures, radii …) by name, one value per sample.
+    /// SI units except temperatures (°C); see [`Loaded::report`] for their units.
     pub extra: Vec<(String, Vec<f64>)>,
     /// Test segments, in time order.
     pub segments: Vec<Segment>,
-    /// Per sample: +1 slip rising, −1 falling, 0 unknown.
+    /// Per sample: +1 swept slip rising (dα/dt > 0 in lateral, dκ/dt > 0 in
+    /// longitudinal/combined segments), −1 falling, 0 unknown / outside segments.
     pub sweep_dir: Vec<i8>,
-    /// Per sample: time since its segment began (s).
+    /// Per sample: time since its segment began (s); NaN outside segments.
     pub t_in_segment: Vec<f64>,
+}
+
+/// Names of the [`Sample`] channels, in CSV column order.
+pub const SAMPLE_CHANNELS: [&str; 14] = [
+    "time", "Vx", "omega", "Fz", "kappa", "alpha", "gamma", "phit", "P", "Fx", "Fy", "Mx", "My",
+    "Mz",
+];
+
+impl Sample {
+    /// Value of a channel by its [`SAMPLE_CHANNELS`] name.
+    pub fn get(&self, name: &str) -> f64 {
+        self.values()[SAMPLE_CHANNELS
+            .iter()
+            .position(|c| c.eq_ignore_ascii_case(name))
+            .unwrap_or(0)]
+    }
+    /// All values in [`SAMPLE_CHANNELS`] order.
+    pub fn values(&self) -> [f64; 14] {
+        [
+            self.time, self.vx, self.omega, self.fz, self.kappa, self.alpha, self.gamma, self.phit,
+            self.p, self.fx, self.fy, self.mx, self.my, self.mz,
+        ]
+    }
+    /// Build from values in [`SAMPLE_CHANNELS`] order.
+    pub fn from_values(v: &[f64; 14]) -> Sample {
+        Sample {
+            time: v[0],
+            vx: v[1],
+            omega: v[2],
+            fz: v[3],
+            kappa: v[4],
+            alpha: v[5],
+            gamma: v[6],
+            phit: v[7],
+            p: v[8],
+            fx: v[9],
+            fy: v[10],
+            mx: v[11],
+            my: v[12],
+            mz: v[13],
+        }
+    }
 }
 
 impl Recording {
@@ -87,4 +173,748 @@ impl Recording {
             .iter()
             .any(|c| c.eq_ignore_ascii_case(channel))
     }
+    /// Extra channel by name (case-insensitive).
+    pub fn extra(&self, name: &str) -> Option<&[f64]> {
+        self.extra
+            .iter()
+            .find(|(n, _)| n.eq_ignore_ascii_case(name))
+            .map(|(_, v)| v.as_slice())
+    }
+    /// Read any supported file with default options (report discarded; use
+    /// [`load`] to see dropped rows, missing channels and the warm-up cut).
+    pub fn from_file(path: &Path) -> Result<Recording> {
+        Ok(load(path, &LoadOptions::default())?.recording)
+    }
+    /// The samples of segment `k` (empty when out of range).
+    pub fn segment_samples(&self, k: usize) -> &[Sample] {
+        self.segments.get(k).map_or(&[][..], |g| {
+            &self.samples[g.start.min(self.samples.len())..g.end.min(self.samples.len())]
+        })
+    }
+    /// Index of the segment holding sample `i`.
+    pub fn segment_of(&self, i: usize) -> Option<usize> {
+        let k = self.segments.partition_point(|s| s.end <= i);
+        (k < self.segments.len() && self.segments[k].start <= i).then_some(k)
+    }
+}
+
+/// File formats.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum Format {
+    /// FSAE TTC / Calspan MATLAB export (.mat, level 5).
+    TtcMat,
+    /// FSAE TTC / Calspan text export (.dat): names row, units row, data.
+    TtcDat,
+    /// TYDEX (.tdx).
+    Tydex,
+    /// CSV with a header (ISO-W SI unless units are given in the header).
+    Csv,
+}
+
+impl Format {
+    /// Parse `mat` | `dat` | `tdx` | `tydex` | `csv`.
+    pub fn parse(s: &str) -> Option<Format> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "mat" | "ttc-mat" => Some(Format::TtcMat),
+            "dat" | "ttc-dat" | "ttc" => Some(Format::TtcDat),
+            "tdx" | "tydex" => Some(Format::Tydex),
+            "csv" => Some(Format::Csv),
+            _ => None,
+        }
+    }
+    /// Detect from content (magic bytes / markers) and then extension.
+    pub fn detect(path: &Path, bytes: &[u8]) -> Option<Format> {
+        let head = &bytes[..bytes.len().min(4096)];
+        let text = String::from_utf8_lossy(head);
+        if bytes.len() >= 128 && (&bytes[126..128] == b"IM" || &bytes[126..128] == b"MI") {
+            return Some(Format::TtcMat);
+        }
+        if text.contains("**HEADER") || text.contains("**MEASURCHANNELS") {
+            return Some(Format::Tydex);
+        }
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        match ext.as_str() {
+            "mat" => Some(Format::TtcMat),
+            "tdx" => Some(Format::Tydex),
+            "dat" => Some(Format::TtcDat),
+            "csv" => Some(Format::Csv),
+            _ => {
+                let first = text.lines().next().unwrap_or("");
+                if first.contains(',') {
+                    Some(Format::Csv)
+                } else if first.contains('\t') {
+                    Some(Format::TtcDat)
+                } else {
+                    None
+                }
+            }
+        }
+    }
+    /// Axis system this format uses unless told otherwise.
+    pub fn default_axes(self) -> AxisSystem {
+        match self {
+            Format::TtcMat | Format::TtcDat => AxisSystem::Sae,
+            Format::Tydex => AxisSystem::TydexW,
+            Format::Csv => AxisSystem::Iso,
+        }
+    }
+}
+
+/// One column as stored in a file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RawColumn {
+    pub name: String,
+    /// Unit as written in the file (`None` when the file gives none).
+    pub unit: Option<String>,
+    pub data: Vec<f64>,
+}
+
+/// A file's content before interpretation: columns with names and units.
+#[derive(Clone, Debug, Default)]
+pub struct RawTable {
+    pub columns: Vec<RawColumn>,
+    /// Header/metadata entries (TTC `source`, `testid`, `tireid`; TYDEX header …).
+    pub meta: Vec<(String, String)>,
+    /// Axis system the file declares, if it does.
+    pub axes: Option<AxisSystem>,
+}
+
+impl RawTable {
+    /// Column by name (case-insensitive).
+    pub fn column(&self, name: &str) -> Option<&RawColumn> {
+        self.columns
+            .iter()
+            .find(|c| c.name.eq_ignore_ascii_case(name))
+    }
+    /// Number of rows (the shortest column).
+    pub fn rows(&self) -> usize {
+        self.columns.iter().map(|c| c.data.len()).min().unwrap_or(0)
+    }
+}
+
+/// How the effective rolling radius in κ = Ω·Re/(V·cos α) − 1 is chosen.
+#[derive(Clone, Debug, Default)]
+pub enum ReChoice {
+    /// The recorded RE channel, sample by sample. On a drive/brake rig the
+    /// recorded RE is typically V/Ω, which slip itself disturbs: κ from it is
+    /// biased towards zero in drive/brake runs.
+    Recorded,
+    /// The recorded loaded radius RL (underestimates Re by a few %).
+    Loaded,
+    /// The model's Re(Fz, …) via `Tyre::evaluate(...).re`.
+    Model(Box<crate::mf::Tyre>),
+    /// Re(Fz) fitted (Re = a + b·Fz, least squares) to the recorded RE over
+    /// free-rolling samples (|α| < 1°, |Fx| < 5 % Fz), where it is undisturbed;
+    /// falls back to [`ReChoice::Recorded`] then [`ReChoice::Loaded`].
+    #[default]
+    FreeRolling,
+}
+
+impl ReChoice {
+    /// Parse `recorded` | `loaded` | `free-rolling` (the model choice needs a tyre).
+    pub fn parse(s: &str) -> Option<ReChoice> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "recorded" | "re" => Some(ReChoice::Recorded),
+            "loaded" | "rl" => Some(ReChoice::Loaded),
+            "free-rolling" | "freerolling" | "auto" => Some(ReChoice::FreeRolling),
+            _ => None,
+        }
+    }
+}
+
+/// Where κ comes from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum KappaSource {
+    /// A recorded κ channel when the format has one (CSV/TYDEX `kappa`,
+    /// MFeval's `SR`), otherwise computed from wheel speed.
+    #[default]
+    Auto,
+    /// Always computed from Ω, Re, V and α.
+    Computed,
+    /// Only the recorded channel (missing → κ missing).
+    Recorded,
+}
+
+/// Options of [`load`].
+#[derive(Clone, Debug)]
+pub struct LoadOptions {
+    /// Force a format instead of detecting it.
+    pub format: Option<Format>,
+    /// Force an axis system instead of the format's/file's.
+    pub axes: Option<AxisSystem>,
+    /// Effective rolling radius for κ.
+    pub re: ReChoice,
+    /// Where κ comes from.
+    pub kappa: KappaSource,
+    /// Detect and cut the warm-up.
+    pub remove_warmup: bool,
+    /// Segmentation tolerances.
+    pub segmentation: structure::SegmentOptions,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        LoadOptions {
+            format: None,
+            axes: None,
+            re: ReChoice::default(),
+            kappa: KappaSource::default(),
+            remove_warmup: true,
+            segmentation: structure::SegmentOptions::default(),
+        }
+    }
+}
+
+/// What loading did to the file: the honest account users need.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct LoadReport {
+    pub file: String,
+    pub format: String,
+    pub axes: String,
+    /// Rows in the file.
+    pub rows_read: usize,
+    /// Rows dropped, by reason ("Fy: NaN", "alpha: out of range [-1.571, 1.571]" …).
+    pub dropped: Vec<(String, usize)>,
+    /// Total rows dropped (a row is counted once, under its first failing channel).
+    pub dropped_total: usize,
+    /// Sample channels the file lacks.
+    pub missing: Vec<String>,
+    /// Extra channels kept, with their units.
+    pub extra_units: Vec<(String, String)>,
+    /// How κ was obtained.
+    pub kappa: String,
+    /// The warm-up cut, if any.
+    pub warmup: Option<structure::WarmupCut>,
+    /// Other remarks (unknown units of extra channels, time going backwards …).
+    pub notes: Vec<String>,
+    /// File metadata (TTC source/testid/tireid, TYDEX header).
+    pub meta: Vec<(String, String)>,
+}
+
+/// A loaded recording with its report.
+#[derive(Clone, Debug)]
+pub struct Loaded {
+    pub recording: Recording,
+    pub report: LoadReport,
+}
+
+fn rec_err(file: &str, location: impl Into<String>, message: impl Into<String>) -> Error {
+    Error::Recording {
+        file: file.to_string(),
+        location: location.into(),
+        message: message.into(),
+    }
+}
+
+/// Read a file into its raw table.
+pub fn read_raw(path: &Path, format: Option<Format>) -> Result<(RawTable, Format)> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let file = path.display().to_string();
+    let format = match format.or_else(|| Format::detect(path, &bytes)) {
+        Some(f) => f,
+        None => {
+            return Err(rec_err(
+                &file,
+                "file",
+                "cannot tell the format (not a MAT file, no TYDEX markers, unknown extension); use --format mat|dat|tdx|csv",
+            ))
+        }
+    };
+    let raw = match format {
+        Format::TtcMat => ttc::read_mat(&bytes, &file)?,
+        Format::TtcDat => ttc::read_dat(&bytes, &file)?,
+        Format::Tydex => tdx::read(&bytes, &file)?,
+        Format::Csv => csvio::read(&bytes, &file)?,
+    };
+    Ok((raw, format))
+}
+
+/// Read, convert and structure a recording.
+pub fn load(path: &Path, opts: &LoadOptions) -> Result<Loaded> {
+    let (raw, format) = read_raw(path, opts.format)?;
+    from_raw(raw, format, &path.display().to_string(), opts)
+}
+
+/// The core channels and their aliases (case-insensitive, unit suffix removed).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Ch {
+    Time,
+    Vx,
+    Speed,
+    Omega,
+    Fz,
+    Kappa,
+    Alpha,
+    Gamma,
+    Phit,
+    P,
+    Fx,
+    Fy,
+    Mx,
+    My,
+    Mz,
+}
+
+const ALIASES: &[(Ch, Dim, &[&str])] = &[
+    (
+        Ch::Time,
+        Dim::Time,
+        &["time", "t", "et", "elapsed_time", "runtime"],
+    ),
+    (Ch::Vx, Dim::Speed, &["vx", "longvel", "vx_w"]),
+    (
+        Ch::Speed,
+        Dim::Speed,
+        &["v", "speed", "roadspeed", "road_speed", "vel"],
+    ),
+    (
+        Ch::Omega,
+        Dim::AngularSpeed,
+        &[
+            "omega",
+            "w",
+            "n",
+            "wheelspeed",
+            "wheel_speed",
+            "rotspeed",
+            "rotveloc",
+            "omega_w",
+        ],
+    ),
+    (Ch::Fz, Dim::Force, &["fz", "fzw", "fzc", "fz_w", "load"]),
+    (
+        Ch::Kappa,
+        Dim::Ratio,
+        &["kappa", "longslip", "long_slip", "slipratio", "slip_ratio"],
+    ),
+    (
+        Ch::Alpha,
+        Dim::Angle,
+        &["alpha", "sa", "slipangl", "slipangle", "slip_angle"],
+    ),
+    (
+        Ch::Gamma,
+        Dim::Angle,
+        &[
+            "gamma",
+            "ia",
+            "inclangl",
+            "inclination",
+            "camber",
+            "incl_angle",
+        ],
+    ),
+    (
+        Ch::Phit,
+        Dim::InvLength,
+        &["phit", "phi_t", "turnslip", "turn_slip"],
+    ),
+    (
+        Ch::P,
+        Dim::Pressure,
+        &["p", "pressure", "inflpres", "infl_pressure"],
+    ),
+    (Ch::Fx, Dim::Force, &["fx", "fxw", "fxc", "fx_w"]),
+    (Ch::Fy, Dim::Force, &["fy", "fyw", "fyc", "fy_w"]),
+    (Ch::Mx, Dim::Moment, &["mx", "mxw", "mxc", "mx_w"]),
+    (Ch::My, Dim::Moment, &["my", "myw", "myc", "my_w"]),
+    (Ch::Mz, Dim::Moment, &["mz", "mzw", "mzc", "mz_w"]),
+];
+
+/// Known extra channels and their dimension (radii, slips, temperatures).
+fn extra_dim(name: &str) -> Option<Dim> {
+    let n = name.to_ascii_lowercase();
+    match n.as_str() {
+        "rl" | "re" | "r_l" | "r_e" | "rloaded" | "reff" | "radload" | "radeff" => {
+            Some(Dim::Length)
+        }
+        "sr" | "sl" | "nfx" | "nfy" => Some(Dim::Ratio),
+        "rst" | "ambtmp" => Some(Dim::Temperature),
+        _ if n.starts_with("tst") || n.contains("tmp") || n.contains("temp") => {
+            Some(Dim::Temperature)
+        }
+        _ => None,
+    }
+}
+
+/// SI unit this crate stores an extra channel in ("-" when unknown).
+pub fn extra_si_unit(name: &str) -> &'static str {
+    extra_dim(name).map_or("-", |d| d.si())
+}
+
+/// Canonical extra name: radii as `Rl`/`Re`, the rest as written.
+fn extra_name(name: &str) -> String {
+    match name.to_ascii_lowercase().as_str() {
+        "rl" | "r_l" | "rloaded" | "radload" => "Rl".into(),
+        "re" | "r_e" | "reff" | "radeff" => "Re".into(),
+        _ => name.to_string(),
+    }
+}
+
+/// Range checks on ISO-W SI values: (channel, min, max).
+const RANGES: [(&str, f64, f64); 13] = [
+    ("time", f64::MIN, f64::MAX),
+    ("Vx", -150.0, 150.0),
+    ("omega", -3000.0, 3000.0),
+    ("Fz", -500.0, 2e5),
+    ("kappa", -10.0, 10.0),
+    (
+        "alpha",
+        -std::f64::consts::FRAC_PI_2,
+        std::f64::consts::FRAC_PI_2,
+    ),
+    ("gamma", -0.6, 0.6),
+    ("phit", -100.0, 100.0),
+    ("P", 0.0, 2e7),
+    ("Fx", -2e5, 2e5),
+    ("Fy", -2e5, 2e5),
+    ("Mx", -5e4, 5e4),
+    ("Mz", -5e4, 5e4),
+];
+
+/// Interpret a raw table: see the module documentation for the steps.
+pub fn from_raw(raw: RawTable, format: Format, file: &str, opts: &LoadOptions) -> Result<Loaded> {
+    let ttc = matches!(format, Format::TtcMat | Format::TtcDat);
+    let axes = opts.axes.or(raw.axes).unwrap_or(format.default_axes());
+    let n = raw.rows();
+    let mut report = LoadReport {
+        file: file.to_string(),
+        format: format!("{format:?}"),
+        axes: axes.name().into(),
+        rows_read: n,
+        meta: raw.meta.clone(),
+        ..Default::default()
+    };
+    if n == 0 {
+        return Err(rec_err(file, "data", "no data rows"));
+    }
+    // Identify the core channels; everything else is extra.
+    let mut core: Vec<(Ch, Vec<f64>)> = Vec::new();
+    let mut extra: Vec<(String, Vec<f64>)> = Vec::new();
+    for col in &raw.columns {
+        let (name, hdr_unit) = units::split_header(&col.name);
+        let unit = col.unit.clone().or(hdr_unit);
+        let lname = name.to_ascii_lowercase();
+        // TTC: SR/SL are Calspan's own slip ratios, kept as extras; elsewhere SR is κ.
+        let is_kappa_alias = !ttc && (lname == "sr" || lname == "slip");
+        let found = ALIASES
+            .iter()
+            .find(|(_, _, al)| al.contains(&lname.as_str()))
+            .map(|(c, d, _)| (*c, *d))
+            .or(if is_kappa_alias {
+                Some((Ch::Kappa, Dim::Ratio))
+            } else {
+                None
+            });
+        if let Some((ch, dim)) = found {
+            if core.iter().any(|(c, _)| *c == ch) {
+                report.notes.push(format!(
+                    "column '{}' duplicates an earlier {ch:?} column: kept as extra",
+                    col.name
+                ));
+                report
+                    .extra_units
+                    .push((name.clone(), unit.clone().unwrap_or_default()));
+                extra.push((name.clone(), col.data[..n].to_vec()));
+                continue;
+            }
+            // CSV without units is ISO-W SI by definition of the format.
+            let conv = match &unit {
+                Some(u) => units::to_si(dim, u).ok_or_else(|| {
+                    rec_err(
+                        file,
+                        format!("channel '{name}'"),
+                        format!(
+                            "unknown unit '{u}' for a {dim:?} channel (expected e.g. {})",
+                            dim.si()
+                        ),
+                    )
+                })?,
+                None if format == Format::Csv => units::ToSi {
+                    scale: 1.0,
+                    offset: 0.0,
+                },
+                None => {
+                    return Err(rec_err(
+                        file,
+                        format!("channel '{name}'"),
+                        "the file gives no unit for this channel",
+                    ));
+                }
+            };
+            let data: Vec<f64> = col.data[..n]
+                .iter()
+                .map(|&x| x * conv.scale + conv.offset)
+                .collect();
+            core.push((ch, data));
+        } else {
+            let ename = extra_name(&name);
+            let mut data = col.data[..n].to_vec();
+            let mut unit_out = unit.clone().unwrap_or_default();
+            if let (Some(dim), Some(u)) = (extra_dim(&name), unit.as_ref()) {
+                if let Some(c) = units::to_si(dim, u) {
+                    data.iter_mut().for_each(|x| *x = *x * c.scale + c.offset);
+                    unit_out = dim.si().into();
+                } else {
+                    report
+                        .notes
+                        .push(format!("extra channel '{name}': unit '{u}' not converted"));
+                }
+            } else if let (Some(dim), None) = (extra_dim(&name), unit.as_ref()) {
+                unit_out = dim.si().into();
+            }
+            report.extra_units.push((ename.clone(), unit_out));
+            extra.push((ename, data));
+        }
+    }
+    let get = |c: Ch| {
+        core.iter()
+            .find(|(x, _)| *x == c)
+            .map(|(_, v)| v.as_slice())
+    };
+    let nan = vec![f64::NAN; n];
+    let col = |c: Ch| get(c).unwrap_or(&nan);
+    let rl_col = extra
+        .iter()
+        .find(|(nm, _)| nm == "Rl")
+        .map(|(_, v)| v.clone());
+
+    // Build ISO-W samples.
+    let alpha_raw = col(Ch::Alpha);
+    let conv = conventions::ToIso::new(axes);
+    let mut samples: Vec<Sample> = Vec::with_capacity(n);
+    for i in 0..n {
+        let a = AxisSample {
+            fx: col(Ch::Fx)[i],
+            fy: col(Ch::Fy)[i],
+            fz: col(Ch::Fz)[i],
+            mx: col(Ch::Mx)[i],
+            my: col(Ch::My)[i],
+            mz: col(Ch::Mz)[i],
+            alpha: alpha_raw[i],
+            gamma: col(Ch::Gamma)[i],
+            kappa: col(Ch::Kappa)[i],
+            phit: col(Ch::Phit)[i],
+            rl: rl_col.as_ref().map_or(f64::NAN, |r| r[i]),
+        };
+        let w = conv.apply(&a);
+        let vx = match (get(Ch::Vx), get(Ch::Speed)) {
+            (Some(v), _) => v[i],
+            (None, Some(v)) => {
+                v[i] * if w.alpha.is_finite() {
+                    w.alpha.cos()
+                } else {
+                    1.0
+                }
+            }
+            _ => f64::NAN,
+        };
+        samples.push(Sample {
+            time: col(Ch::Time)[i],
+            vx,
+            omega: col(Ch::Omega)[i].abs(),
+            fz: w.fz,
+            kappa: w.kappa,
+            alpha: w.alpha,
+            gamma: w.gamma,
+            phit: w.phit,
+            p: col(Ch::P)[i],
+            fx: w.fx,
+            fy: w.fy,
+            mx: w.mx,
+            my: w.my,
+            mz: w.mz,
+        });
+    }
+    if axes == AxisSystem::TydexC && rl_col.is_none() {
+        return Err(rec_err(
+            file,
+            "channel 'RL'",
+            "TYDEX C recordings need the loaded radius to move moments to the contact point",
+        ));
+    }
+    let mut channels: Vec<String> = Vec::new();
+    let has = |c: Ch| get(c).is_some();
+    for (name, ok) in [
+        ("time", has(Ch::Time)),
+        ("Vx", has(Ch::Vx) || has(Ch::Speed)),
+        ("omega", has(Ch::Omega)),
+        ("Fz", has(Ch::Fz)),
+        ("kappa", has(Ch::Kappa)),
+        ("alpha", has(Ch::Alpha)),
+        ("gamma", has(Ch::Gamma)),
+        ("phit", has(Ch::Phit)),
+        ("P", has(Ch::P)),
+        ("Fx", has(Ch::Fx)),
+        ("Fy", has(Ch::Fy)),
+        ("Mx", has(Ch::Mx)),
+        ("My", has(Ch::My)),
+        ("Mz", has(Ch::Mz)),
+    ] {
+        if ok {
+            channels.push(name.into());
+        }
+    }
+    if !has(Ch::Time) {
+        // A recording without time gets the row index as time, said loudly.
+        report
+            .notes
+            .push("no time channel: time = row index (s)".into());
+        samples
+            .iter_mut()
+            .enumerate()
+            .for_each(|(i, s)| s.time = i as f64);
+        channels.insert(0, "time".into());
+    }
+    if !has(Ch::Fz) {
+        return Err(rec_err(
+            file,
+            "channel 'FZ'",
+            "no normal load channel (FZ/Fz): cannot interpret a tyre recording without it",
+        ));
+    }
+
+    // κ from wheel speed, if asked or needed (before the row filter so that
+    // non-finite κ is counted as a dropped row).
+    let want_computed = match opts.kappa {
+        KappaSource::Computed => true,
+        KappaSource::Recorded => false,
+        KappaSource::Auto => !has(Ch::Kappa),
+    };
+    if want_computed {
+        let re = extra
+            .iter()
+            .find(|(nm, _)| nm == "Re")
+            .map(|(_, v)| v.as_slice());
+        let rl = rl_col.as_deref();
+        match slip::compute_kappa(&mut samples, re, rl, &opts.re) {
+            Some(how) => {
+                if has(Ch::Kappa) {
+                    report
+                        .notes
+                        .push("recorded κ replaced by κ computed from wheel speed".into());
+                }
+                report.kappa = how;
+                if !channels.iter().any(|c| c == "kappa") {
+                    channels.push("kappa".into());
+                }
+            }
+            None => {
+                report.kappa = "missing (no wheel speed / radius to compute it)".into();
+            }
+        }
+    } else if has(Ch::Kappa) {
+        report.kappa = "recorded channel".into();
+    } else {
+        report.kappa = "missing".into();
+    }
+    let sample_ch_order = SAMPLE_CHANNELS;
+    channels.sort_by_key(|c| sample_ch_order.iter().position(|x| x == c).unwrap_or(99));
+    for c in SAMPLE_CHANNELS {
+        if !channels.iter().any(|x| x == c) {
+            report.missing.push(c.to_string());
+        }
+    }
+
+    // Drop rows with NaN/out-of-range values in the channels the file has.
+    let checks: Vec<(usize, f64, f64)> = RANGES
+        .iter()
+        .filter(|(c, _, _)| channels.iter().any(|x| x == c))
+        .map(|(c, lo, hi)| {
+            (
+                SAMPLE_CHANNELS.iter().position(|x| x == c).unwrap_or(0),
+                *lo,
+                *hi,
+            )
+        })
+        .collect();
+    let mut counts = vec![0usize; SAMPLE_CHANNELS.len() * 2];
+    let mut keep = vec![true; n];
+    for (i, s) in samples.iter().enumerate() {
+        let v = s.values();
+        for &(k, lo, hi) in &checks {
+            let x = v[k];
+            if !x.is_finite() {
+                counts[2 * k] += 1;
+                keep[i] = false;
+                break;
+            }
+            if x < lo || x > hi {
+                counts[2 * k + 1] += 1;
+                keep[i] = false;
+                break;
+            }
+        }
+    }
+    for (k, c) in SAMPLE_CHANNELS.iter().enumerate() {
+        if counts[2 * k] > 0 {
+            report
+                .dropped
+                .push((format!("{c}: NaN or infinite"), counts[2 * k]));
+        }
+        if counts[2 * k + 1] > 0 {
+            let (_, lo, hi) = RANGES
+                .iter()
+                .find(|(x, _, _)| x == c)
+                .copied()
+                .unwrap_or(("", 0.0, 0.0));
+            report.dropped.push((
+                format!("{c}: outside [{lo}, {hi}] (ISO-W SI)"),
+                counts[2 * k + 1],
+            ));
+        }
+    }
+    report.dropped_total = keep.iter().filter(|k| !**k).count();
+    if report.dropped_total > 0 {
+        let mut j = 0;
+        samples.retain(|_| {
+            j += 1;
+            keep[j - 1]
+        });
+        for (_, v) in extra.iter_mut() {
+            let mut j = 0;
+            v.retain(|_| {
+                j += 1;
+                keep[j - 1]
+            });
+        }
+    }
+    if samples.is_empty() {
+        return Err(rec_err(
+            file,
+            "data",
+            format!("all {n} rows were dropped: {:?}", report.dropped),
+        ));
+    }
+    if samples.windows(2).any(|w| w[1].time < w[0].time) {
+        report
+            .notes
+            .push("time goes backwards somewhere: segments are split there".into());
+    }
+
+    let mut rec = Recording {
+        source: raw
+            .meta
+            .iter()
+            .find(|(k, _)| k.eq_ignore_ascii_case("source"))
+            .map(|(_, v)| format!("{file} ({v})"))
+            .unwrap_or_else(|| file.to_string()),
+        samples,
+        channels,
+        extra,
+        ..Default::default()
+    };
+    structure::apply(
+        &mut rec,
+        opts.remove_warmup,
+        &opts.segmentation,
+        &mut report,
+    );
+    Ok(Loaded {
+        recording: rec,
+        report,
+    })
 }

@@ -1,0 +1,158 @@
+//! slip — longitudinal slip from wheel speed:
+//! κ = Ω·Re/(V·cos α) − 1 = Ω·Re/Vx − 1 (Pacejka, *Tyre and Vehicle
+//! Dynamics*, 3rd ed., eq. 2.9/§2.2: κ = −Vsx/Vx with Vsx = Vx − Ω·Re),
+//! with the effective rolling radius Re chosen by [`ReChoice`].
+//!
+//! Rig caveat: flat-belt rigs (Calspan TIRF) report RE as V/Ω. That equals
+//! the effective rolling radius only while the tyre rolls freely; under drive
+//! or brake torque it follows the slip itself (κ from it would be ≈ 0), which
+//! is why the default fits Re(Fz) on the free-rolling samples only.
+//!
+//! Must never: divide by a zero speed (such samples get κ = NaN and are then
+//! dropped and counted by the loader).
+
+use super::{ReChoice, Sample};
+use crate::mf::{MfInput, UseMode};
+
+/// Least-squares line y = a + b·x (b = 0 when x has no spread).
+pub fn fit_line(x: &[f64], y: &[f64]) -> Option<(f64, f64)> {
+    let n = x.len() as f64;
+    if x.is_empty() {
+        return None;
+    }
+    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let sxx: f64 = x.iter().map(|v| (v - mx).powi(2)).sum();
+    let sxy: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let b = if sxx > 1e-12 * n * (mx * mx + 1.0) {
+        sxy / sxx
+    } else {
+        0.0
+    };
+    Some((my - b * mx, b))
+}
+
+/// Re(Fz) = a + b·Fz fitted on free-rolling samples (|α| < 1°, |Fx| < 5 % Fz,
+/// finite RE). Needs at least 20 such samples.
+pub fn free_rolling_re(samples: &[Sample], re: &[f64]) -> Option<(f64, f64)> {
+    let lim = 1f64.to_radians();
+    let (mut x, mut y) = (Vec::new(), Vec::new());
+    for (s, &r) in samples.iter().zip(re) {
+        let fx_ok = !s.fx.is_finite() || s.fx.abs() < 0.05 * s.fz.abs();
+        if s.alpha.abs() < lim && fx_ok && r.is_finite() && r > 0.0 && s.fz > 0.0 {
+            x.push(s.fz);
+            y.push(r);
+        }
+    }
+    if x.len() < 20 {
+        return None;
+    }
+    fit_line(&x, &y)
+}
+
+/// Effective and loaded radius (Re, Rl) from a model evaluation, with
+/// fallbacks where the model reports none (non-finite, implausible, or
+/// exactly the unloaded radius under load): Rl = R0 − Fz/Cz and
+/// Re = R0 − Fz/(3·Cz) (Pacejka, *Tyre and Vehicle Dynamics*, 3rd ed.,
+/// §9.2.1: Re lies about a third of the deflection below R0).
+pub fn model_radii(tyre: &crate::mf::Tyre, fz: f64, re: f64, rl: f64) -> (f64, f64) {
+    let p = &tyre.params().p;
+    let r0 = p.unloaded_radius;
+    let cz = if p.vertical_stiffness > 0.0 {
+        p.vertical_stiffness
+    } else {
+        2e5
+    };
+    let defl = fz.max(0.0) / cz;
+    let rl = if rl.is_finite() && rl > 0.2 * r0 {
+        rl
+    } else {
+        r0 - defl
+    };
+    let re = if re.is_finite() && re > 0.2 * r0 && ((re - r0).abs() > 1e-12 || defl == 0.0) {
+        re
+    } else {
+        r0 - defl / 3.0
+    };
+    (re, rl)
+}
+
+/// κ for one sample given Re.
+#[inline]
+pub fn kappa(omega: f64, re: f64, vx: f64) -> f64 {
+    if vx.abs() < 1e-3 || !re.is_finite() || !omega.is_finite() {
+        return f64::NAN;
+    }
+    omega * re / vx - 1.0
+}
+
+/// Compute κ for all samples; returns a description of the Re used, or
+/// `None` when Ω or V is missing or no radius is available.
+pub fn compute_kappa(
+    samples: &mut [Sample],
+    re: Option<&[f64]>,
+    rl: Option<&[f64]>,
+    choice: &ReChoice,
+) -> Option<String> {
+    if samples.iter().all(|s| !s.omega.is_finite()) || samples.iter().all(|s| !s.vx.is_finite()) {
+        return None;
+    }
+    let mut choice = choice.clone();
+    if let ReChoice::FreeRolling = choice {
+        if let Some((a, b)) = re.and_then(|r| free_rolling_re(samples, r)) {
+            for s in samples.iter_mut() {
+                s.kappa = kappa(s.omega, a + b * s.fz, s.vx);
+            }
+            return Some(format!(
+                "κ = Ω·Re/(V·cos α) − 1 with Re(Fz) = {a:.5} m {} {:.3e} m/N·Fz fitted to the recorded RE on free-rolling samples",
+                if b < 0.0 { "−" } else { "+" },
+                b.abs()
+            ));
+        }
+        choice = if re.is_some() {
+            ReChoice::Recorded
+        } else {
+            ReChoice::Loaded
+        };
+    }
+    match choice {
+        ReChoice::Recorded => {
+            let re = re?;
+            for (s, r) in samples.iter_mut().zip(re) {
+                s.kappa = kappa(s.omega, *r, s.vx);
+            }
+            Some("κ = Ω·Re/(V·cos α) − 1 with the recorded RE (disturbed by slip in drive/brake runs)".into())
+        }
+        ReChoice::Loaded => {
+            let rl = rl?;
+            for (s, r) in samples.iter_mut().zip(rl) {
+                s.kappa = kappa(s.omega, *r, s.vx);
+            }
+            Some(
+                "κ = Ω·Rl/(V·cos α) − 1 with the recorded loaded radius (κ biased low by Re − Rl)"
+                    .into(),
+            )
+        }
+        ReChoice::Model(tyre) => {
+            for s in samples.iter_mut() {
+                let inp = MfInput {
+                    fz: s.fz,
+                    kappa: 0.0,
+                    alpha: 0.0,
+                    gamma: s.gamma,
+                    phit: 0.0,
+                    vx: s.vx,
+                    p: s.p,
+                    omega: s.omega,
+                };
+                let o = tyre.evaluate(&inp, UseMode::default());
+                let r = model_radii(&tyre, s.fz, o.re, o.rl).0;
+                s.kappa = kappa(s.omega, r, s.vx);
+            }
+            Some(format!(
+                "κ = Ω·Re/(V·cos α) − 1 with the model's Re(Fz) ({})",
+                tyre.params().source
+            ))
+        }
+        ReChoice::FreeRolling => None,
+    }
+}

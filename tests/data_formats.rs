@@ -1,0 +1,252 @@
+//! Readers and writers: CSV and TYDEX round trips, MFeval-style aliases with
+//! `[unit]` suffixes, rows with NaN / out-of-range values dropped and
+//! counted, missing channels reported, and malformed or truncated files
+//! rejected with an error naming the file and the place.
+
+use std::path::PathBuf;
+use tyrekit::data::{csvio, load, tdx, Format, LoadOptions, Loaded};
+use tyrekit::mf::Tyre;
+use tyrekit::rig::{simulate, RigConfig, SteadyMf};
+use tyrekit::Error;
+
+fn tmp(name: &str, content: &[u8]) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("tyrekit-data-formats-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    let p = d.join(name);
+    std::fs::write(&p, content).unwrap();
+    p
+}
+
+fn load_str(name: &str, content: &str) -> tyrekit::Result<Loaded> {
+    load(&tmp(name, content.as_bytes()), &LoadOptions::default())
+}
+
+fn expect_recording_error(r: tyrekit::Result<Loaded>, want_loc: &str) -> String {
+    match r {
+        Err(Error::Recording {
+            file,
+            location,
+            message,
+        }) => {
+            assert!(!file.is_empty());
+            assert!(
+                location.contains(want_loc),
+                "location '{location}' lacks '{want_loc}' ({message})"
+            );
+            message
+        }
+        Err(e) => panic!("wrong error kind: {e}"),
+        Ok(_) => panic!("malformed file accepted"),
+    }
+}
+
+/// Sample-by-sample equality, NaN (absent channel) equal to NaN.
+fn same_samples(a: &[tyrekit::data::Sample], b: &[tyrekit::data::Sample]) {
+    assert_eq!(a.len(), b.len());
+    for (x, y) in a.iter().zip(b) {
+        for (u, v) in x.values().iter().zip(y.values()) {
+            assert!(*u == v || (u.is_nan() && v.is_nan()), "{x:?} vs {y:?}");
+        }
+    }
+}
+
+fn rig_loaded(name: &str) -> Loaded {
+    let tyre = Tyre::builtin();
+    let mut cfg = RigConfig::standard(&tyre, 2);
+    cfg.decimate = 5;
+    cfg.programme.pressures.truncate(1);
+    let r = simulate(&cfg, &mut SteadyMf::new(tyre));
+    let p = tmp(name, &tyrekit::data::ttc::write_mat(&r.table, true));
+    load(&p, &LoadOptions::default()).unwrap()
+}
+
+#[test]
+fn csv_and_tydex_round_trip_the_clean_table() {
+    let l = rig_loaded("small-rt.mat");
+    let rec = &l.recording;
+    let csv = csvio::write(rec);
+    let head = csv.lines().next().unwrap();
+    assert!(
+        head.starts_with("time,Vx,omega,Fz,kappa,alpha,gamma,P,Fx,Fy,Mx,Mz,"),
+        "{head}"
+    );
+    assert!(head.ends_with("segment,sweep_dir,t_in_segment"));
+    let opts = LoadOptions {
+        remove_warmup: false,
+        ..Default::default()
+    };
+    let back = load(&tmp("rt.csv", csv.as_bytes()), &opts).unwrap();
+    same_samples(&back.recording.samples, &rec.samples);
+    assert_eq!(back.report.kappa, "recorded channel");
+    // Same structure found again on the clean table.
+    assert_eq!(back.recording.segments.len(), rec.segments.len());
+    let t = tdx::write(rec);
+    assert!(t.contains("**MEASURCHANNELS") && t.contains("SLIPANGL") && t.ends_with("**END\n"));
+    let back = load(&tmp("rt.tdx", t.as_bytes()), &opts).unwrap();
+    assert_eq!(back.report.format, "Tydex");
+    same_samples(&back.recording.samples, &rec.samples);
+    assert_eq!(back.recording.segments.len(), rec.segments.len());
+}
+
+#[test]
+fn mfeval_aliases_units_nan_and_range() {
+    // MFeval column names with units; degrees and kPa are converted.
+    let text = "Time [s],Vx [m/s],W [rad/s],SA [deg],IA [deg],Rl [m],Re [m],P [kPa],Fx [N],Fy [N],Fz [N],Mx [Nm],Mz [Nm],SR [-],Phit [-]\n\
+        0.0,16,64,1,0,0.25,0.253,83,0,-300,1600,-10,5,0,0\n\
+        0.1,16,64,2,0,0.25,0.253,83,0,NaN,1600,-10,5,0,0\n\
+        0.2,16,64,3,0,0.25,0.253,83,0,-900,1600,-10,5,0,0\n\
+        0.3,16,64,95,0,0.25,0.253,83,0,-900,1600,-10,5,0,0\n\
+        0.4,16,64,4,0,0.25,0.253,83,0,-1100,1600,-10,5,,0\n";
+    let l = load_str("mfeval.csv", text).unwrap();
+    let r = &l.recording;
+    assert_eq!(l.report.rows_read, 5);
+    // NaN Fy, α = 95° and an empty SR are dropped, each counted once.
+    assert_eq!(l.report.dropped_total, 3, "{:?}", l.report.dropped);
+    assert!(l
+        .report
+        .dropped
+        .iter()
+        .any(|(w, n)| w.starts_with("Fy") && *n == 1));
+    assert!(l
+        .report
+        .dropped
+        .iter()
+        .any(|(w, n)| w.starts_with("alpha") && w.contains("outside") && *n == 1));
+    assert!(l
+        .report
+        .dropped
+        .iter()
+        .any(|(w, n)| w.starts_with("kappa") && *n == 1));
+    assert_eq!(r.samples.len(), 2);
+    assert!((r.samples[1].alpha - 3f64.to_radians()).abs() < 1e-15);
+    assert!((r.samples[0].p - 83_000.0).abs() < 1e-9);
+    assert_eq!(l.report.missing, vec!["My".to_string()]);
+    assert!(r.extra("Rl").is_some());
+}
+
+#[test]
+fn missing_channels_are_reported() {
+    let l = load_str(
+        "min.csv",
+        "time,Fz,alpha,Fy\n0,1000,0.01,-100\n0.1,1000,0.02,-200\n",
+    )
+    .unwrap();
+    for m in [
+        "Vx", "omega", "kappa", "gamma", "P", "Fx", "Mx", "My", "Mz", "phit",
+    ] {
+        assert!(
+            l.report.missing.iter().any(|x| x == m),
+            "{m} not reported missing"
+        );
+    }
+    assert!(l.report.kappa.starts_with("missing"));
+    // No normal load: an error, not a guess.
+    expect_recording_error(load_str("nofz.csv", "time,Fy\n0,1\n"), "FZ");
+}
+
+#[test]
+fn malformed_files_name_the_place() {
+    // CSV: short row, non-number.
+    expect_recording_error(
+        load_str("short.csv", "time,Fz,Fy\n0,1000,5\n0.1,1000\n"),
+        "line 3",
+    );
+    let m = expect_recording_error(
+        load_str("text.csv", "time,Fz,Fy\n0,1000,abc\n"),
+        "line 2, column 'Fy'",
+    );
+    assert!(m.contains("abc"));
+    // TTC .dat: unit row mismatch, truncated last row, unknown unit.
+    let dat = "ET\tV\tSA\tFZ\tFY\ns\tkph\tdeg\tN\tN\n0\t40\t1\t-1000\t50\n0.01\t40\t1";
+    expect_recording_error(load_str("trunc.dat", dat), "line 4");
+    let dat = "ET\tV\tSA\tFZ\tFY\ns\tkph\tdeg\tkgf\tN\n0\t40\t1\t-1000\t50\n";
+    let m = expect_recording_error(load_str("unit.dat", dat), "FZ");
+    assert!(m.contains("kgf"));
+    let dat = "ET\tV\tSA\tFZ\tFY\ns\tkph\tdeg\tN\n0\t40\t1\t-1000\t50\n";
+    expect_recording_error(load_str("units.dat", dat), "line 2");
+    // TYDEX without data section, and a data row with too few values.
+    let t = "**HEADER\nRELEASE 1.3\n**MEASURCHANNELS\nRUNTIME time s 1 0 0\nFZW load N 1 0 0\n";
+    expect_recording_error(load_str("nodata.tdx", t), "MEASURDATA");
+    let t = "**HEADER\n**MEASURCHANNELS\nRUNTIME time s 1 0 0\nFZW load N 1 0 0\n**MEASURDATA\n0 1000\n0.1\n**END\n";
+    expect_recording_error(load_str("row.tdx", t), "line 7");
+    // MAT: a valid file cut short.
+    let tyre = Tyre::builtin();
+    let mut cfg = RigConfig::standard(&tyre, 9);
+    cfg.decimate = 50;
+    let r = simulate(&cfg, &mut SteadyMf::new(tyre));
+    let bytes = tyrekit::data::ttc::write_mat(&r.table, true);
+    let p = tmp("cut.mat", &bytes[..bytes.len() * 2 / 3]);
+    let e = load(&p, &LoadOptions::default());
+    let m = expect_recording_error(e, "element");
+    assert!(m.contains("truncated"), "{m}");
+    // Unknown format.
+    let p = tmp("mystery.bin", b"\x00\x01\x02");
+    assert!(matches!(
+        load(&p, &LoadOptions::default()),
+        Err(Error::Recording { .. })
+    ));
+    // Forcing the format overrides detection.
+    let p = tmp("renamed.txt", b"time,Fz\n0,1000\n0.1,1000\n");
+    let o = LoadOptions {
+        format: Some(Format::Csv),
+        ..Default::default()
+    };
+    assert!(load(&p, &o).is_ok());
+}
+
+/// Load speed: a million rows (14 ISO columns) as CSV and as compressed .mat.
+/// Run with `cargo test --release --test data_formats -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn million_rows_load_time() {
+    let n = 1_000_000;
+    let mut s = String::from("time,Vx,omega,Fz,kappa,alpha,gamma,P,Fx,Fy,Mx,My,Mz\n");
+    for i in 0..n {
+        let t = i as f64 * 0.01;
+        let a = (t * 0.3).sin() * 0.2;
+        s.push_str(&format!(
+            "{t},{},{},{},{},{a},0.0349,83000,{},{},{},{},{}\n",
+            16.0 + 0.01 * (t * 2.0).cos(),
+            64.0 + 0.1 * (t * 1.3).sin(),
+            1500.0 + 100.0 * (t * 0.01).sin(),
+            0.01 * (t * 0.7).sin(),
+            -15.0 * a * 1000.0,
+            -20.0 * a * 100.0,
+            30.0 * a,
+            -5.0,
+            8.0 * a * 10.0,
+        ));
+    }
+    let p = tmp("million.csv", s.as_bytes());
+    let t0 = std::time::Instant::now();
+    let l = load(&p, &LoadOptions::default()).unwrap();
+    let dt = t0.elapsed();
+    assert_eq!(
+        l.recording.samples.len()
+            + l.report.dropped_total
+            + l.report.warmup.as_ref().map_or(0, |w| w.samples),
+        n
+    );
+    println!(
+        "1e6-row CSV ({} MB): loaded in {:.3} s",
+        s.len() / 1_000_000,
+        dt.as_secs_f64()
+    );
+    // The same as a TTC .mat (SAE, TTC units, compressed).
+    let tyre = Tyre::builtin();
+    let mut cfg = RigConfig::standard(&tyre, 1);
+    cfg.sample_rate = 800.0;
+    let r = simulate(&cfg, &mut SteadyMf::new(tyre));
+    let bytes = tyrekit::data::ttc::write_mat(&r.table, true);
+    let p = tmp("big.mat", &bytes);
+    let t0 = std::time::Instant::now();
+    let l = load(&p, &LoadOptions::default()).unwrap();
+    println!(
+        "{}-row TTC .mat ({} channels, {} MB compressed): loaded in {:.3} s",
+        r.rows(),
+        r.table.columns.len(),
+        bytes.len() / 1_000_000,
+        t0.elapsed().as_secs_f64()
+    );
+    assert!(l.recording.segments.len() == r.plan.len());
+}

@@ -1,0 +1,145 @@
+//! problem — the interface between a model and the fitter: named, bounded
+//! parameters, a residual vector r(θ) and its exact Jacobian J(θ).
+//!
+//! Must never: know anything about tyres (the Magic Formula stages implement
+//! [`Problem`] elsewhere), or approximate a Jacobian by finite differences
+//! behind the caller's back.
+
+use nalgebra::DMatrix;
+
+/// One model parameter as the fitter sees it.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Param {
+    /// Name (for the MF: the lower-case `.tir` key, e.g. `pdy1`).
+    pub name: String,
+    /// Start value (also the value an unidentifiable parameter is held at).
+    pub start: f64,
+    /// Lower bound (may be `-inf`).
+    pub lower: f64,
+    /// Upper bound (may be `+inf`).
+    pub upper: f64,
+    /// Whether the fitter may move it.
+    pub free: bool,
+}
+
+impl Param {
+    /// A free parameter with bounds.
+    pub fn new(name: &str, start: f64, lower: f64, upper: f64) -> Param {
+        Param {
+            name: name.to_string(),
+            start,
+            lower,
+            upper,
+            free: true,
+        }
+    }
+
+    /// A free parameter without bounds.
+    pub fn unbounded(name: &str, start: f64) -> Param {
+        Param::new(name, start, f64::NEG_INFINITY, f64::INFINITY)
+    }
+
+    /// The same parameter held fixed.
+    pub fn fixed(mut self) -> Param {
+        self.free = false;
+        self
+    }
+
+    /// A typical magnitude of the parameter, used to judge whether its
+    /// Jacobian column is "zero": the box width when both bounds are finite,
+    /// else `max(|start|, 1)`.
+    pub fn scale(&self) -> f64 {
+        let w = self.upper - self.lower;
+        if w.is_finite() && w > 0.0 {
+            w
+        } else {
+            self.start.abs().max(1.0)
+        }
+    }
+
+    /// Clamp a value into the bounds.
+    pub fn clamp(&self, v: f64) -> f64 {
+        v.max(self.lower).min(self.upper)
+    }
+}
+
+/// A least-squares problem: minimise ½ Σ wᵢ ρ(rᵢ(θ)²) over the free parameters.
+///
+/// Residuals are `model − data` (sign does not matter to the fitter but does
+/// to the reports). θ always has one entry per [`Problem::params`] entry,
+/// free or not, in that order.
+///
+/// Implementations should not allocate per residual; the fitter calls
+/// [`Problem::residuals`] for every trial step and [`Problem::jacobian`]
+/// once per accepted step.
+pub trait Problem {
+    /// All parameters, in θ order.
+    fn params(&self) -> &[Param];
+
+    /// Number of residuals m.
+    fn n_residuals(&self) -> usize;
+
+    /// Write r(θ) into `r` (length m).
+    fn residuals(&self, theta: &[f64], r: &mut [f64]);
+
+    /// Write r(θ) into `r` and ∂r/∂θ_{cols[k]} into column k of `jac`
+    /// (m × cols.len(), column-major). Only the listed columns are asked
+    /// for, so a forward-mode AD implementation seeds only those.
+    /// The derivatives must be exact (analytic or AD).
+    fn jacobian(&self, theta: &[f64], cols: &[usize], r: &mut [f64], jac: &mut DMatrix<f64>);
+
+    /// Optional per-residual weights wᵢ ≥ 0 (length m), e.g. 1/σᵢ² of the
+    /// channel. `None` means all ones.
+    fn weights(&self) -> Option<&[f64]> {
+        None
+    }
+}
+
+/// Check a problem's parameter table and a θ against it: finite starts, lower
+/// ≤ start ≤ upper, unique names, θ of the right length.
+pub fn validate(problem: &dyn Problem, theta: &[f64]) -> crate::Result<()> {
+    let params = problem.params();
+    if theta.len() != params.len() {
+        return Err(crate::Error::Input(format!(
+            "fit: {} parameter values given, the problem has {} parameters",
+            theta.len(),
+            params.len()
+        )));
+    }
+    for (i, (p, &v)) in params.iter().zip(theta).enumerate() {
+        if !(p.lower <= p.upper) || p.lower.is_nan() || p.upper.is_nan() {
+            return Err(crate::Error::Input(format!(
+                "fit: parameter '{}': bounds [{}, {}] are not an interval",
+                p.name, p.lower, p.upper
+            )));
+        }
+        if !v.is_finite() || v < p.lower || v > p.upper {
+            return Err(crate::Error::Input(format!(
+                "fit: parameter '{}': value {} is not finite or outside its bounds [{}, {}]",
+                p.name, v, p.lower, p.upper
+            )));
+        }
+        if params[..i].iter().any(|q| q.name == p.name) {
+            return Err(crate::Error::Input(format!(
+                "fit: parameter name '{}' appears twice",
+                p.name
+            )));
+        }
+    }
+    if let Some(w) = problem.weights() {
+        if w.len() != problem.n_residuals() {
+            return Err(crate::Error::Input(format!(
+                "fit: {} weights for {} residuals",
+                w.len(),
+                problem.n_residuals()
+            )));
+        }
+        if let Some(i) = w.iter().position(|x| !(x.is_finite() && *x >= 0.0)) {
+            return Err(crate::Error::Input(format!(
+                "fit: weight {i} is {} (must be finite and ≥ 0)",
+                w[i]
+            )));
+        }
+    }
+    Ok(())
+}

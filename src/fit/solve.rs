@@ -1,0 +1,341 @@
+//! solve — one fit of one [`Problem`]: optional swarm start, identifiability
+//! check, bounded LM polish, standard errors; and a sequence of such fits
+//! (stages) passing the solution on by parameter name.
+//!
+//! Must never: move a parameter the data cannot determine (it is held at its
+//! start value and reported as not identified), or talk to a terminal
+//! (progress goes through the optional callback only).
+
+use super::identify::{identify, standard_errors, IdentifyOptions, Verdict};
+use super::lm::{self, linearise, LmOptions, Termination, Workspace};
+use super::problem::{validate, Problem};
+use super::pso::{self, PsoOptions};
+
+/// Settings of one fit.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FitOptions {
+    pub lm: LmOptions,
+    /// Global start by particle swarm (needs finite bounds on the free parameters).
+    pub pso: Option<PsoOptions>,
+    pub identify: IdentifyOptions,
+}
+
+/// What is happening, for a progress display.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    Swarm,
+    Polish,
+}
+
+/// One progress report.
+#[derive(Clone, Copy, Debug)]
+pub struct Progress<'a> {
+    pub stage: &'a str,
+    pub phase: Phase,
+    /// Iteration within the phase, and its upper limit.
+    pub iteration: usize,
+    pub max_iterations: usize,
+    /// Best cost so far.
+    pub cost: f64,
+}
+
+/// Progress callback type.
+pub type ProgressFn<'a> = dyn FnMut(&Progress) + 'a;
+
+/// How a parameter came out of the fit.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "status", rename_all = "snake_case")]
+pub enum ParamStatus {
+    /// Not free in this fit.
+    Fixed,
+    /// Fitted, inside its bounds.
+    Fitted,
+    /// Fitted, but ended on a bound (its standard error is only indicative).
+    AtBound,
+    /// Free, but the data cannot determine it: held at its start value.
+    NotIdentified { reason: Verdict },
+}
+
+/// One parameter's result.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ParamResult {
+    pub name: String,
+    pub start: f64,
+    pub value: f64,
+    /// Standard error (identified parameters only).
+    pub stderr: Option<f64>,
+    #[serde(flatten)]
+    pub status: ParamStatus,
+}
+
+/// Result of one fit.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct FitOutcome {
+    pub stage: String,
+    /// All parameter values (θ order of the problem).
+    pub theta: Vec<f64>,
+    pub params: Vec<ParamResult>,
+    pub initial_cost: f64,
+    /// Best swarm cost, if a swarm ran.
+    pub swarm_cost: Option<f64>,
+    pub cost: f64,
+    /// Residual variance s² = Σωr²/(m − n_identified).
+    pub residual_variance: f64,
+    pub n_residuals: usize,
+    pub iterations: usize,
+    pub termination: Termination,
+}
+
+impl FitOutcome {
+    /// Value of a parameter by name.
+    pub fn value(&self, name: &str) -> Option<f64> {
+        self.params.iter().find(|p| p.name == name).map(|p| p.value)
+    }
+    /// Result of a parameter by name.
+    pub fn param(&self, name: &str) -> Option<&ParamResult> {
+        self.params.iter().find(|p| p.name == name)
+    }
+}
+
+/// Fit `problem` from `start` (None: the problem's start values) over the
+/// parameters marked in `free` (None: the problem's `free` flags).
+pub fn fit(
+    problem: &dyn Problem,
+    start: Option<&[f64]>,
+    free: Option<&[bool]>,
+    opts: &FitOptions,
+    stage: &str,
+    mut progress: Option<&mut ProgressFn>,
+) -> crate::Result<FitOutcome> {
+    let params = problem.params();
+    let theta0: Vec<f64> = match start {
+        Some(s) => s.to_vec(),
+        None => params.iter().map(|p| p.start).collect(),
+    };
+    validate(problem, &theta0)?;
+    let mut free: Vec<bool> = match free {
+        Some(f) if f.len() == params.len() => f.to_vec(),
+        Some(f) => {
+            return Err(crate::Error::Input(format!(
+                "fit: free mask of length {} for {} parameters",
+                f.len(),
+                params.len()
+            )))
+        }
+        None => params.iter().map(|p| p.free).collect(),
+    };
+    let n_all = params.len();
+    let m = problem.n_residuals();
+    let loss = opts.lm.loss;
+    let mut r = vec![0.0; m];
+    problem.residuals(&theta0, &mut r);
+    let initial_cost = loss.cost(&r, problem.weights());
+
+    // 1. Global start.
+    let mut theta = theta0.clone();
+    let mut swarm_cost = None;
+    if let Some(po) = &opts.pso {
+        let cols: Vec<usize> = (0..n_all).filter(|&i| free[i]).collect();
+        if !cols.is_empty() {
+            let lo: Vec<f64> = cols.iter().map(|&c| params[c].lower).collect();
+            let hi: Vec<f64> = cols.iter().map(|&c| params[c].upper).collect();
+            let x0: Vec<f64> = cols.iter().map(|&c| theta0[c]).collect();
+            let mut th = theta0.clone();
+            let mut cb = |it: usize, c: f64| {
+                if let Some(p) = progress.as_mut() {
+                    p(&Progress {
+                        stage,
+                        phase: Phase::Swarm,
+                        iteration: it,
+                        max_iterations: po.iterations,
+                        cost: c,
+                    })
+                }
+            };
+            let res = pso::minimize(
+                &lo,
+                &hi,
+                Some(&x0),
+                |x| {
+                    for (k, &c) in cols.iter().enumerate() {
+                        th[c] = x[k];
+                    }
+                    problem.residuals(&th, &mut r);
+                    loss.cost(&r, problem.weights())
+                },
+                po,
+                Some(&mut cb),
+            )?;
+            for (k, &c) in cols.iter().enumerate() {
+                theta[c] = res.x[k];
+            }
+            swarm_cost = Some(res.cost);
+        }
+    }
+
+    // 2. Identifiability at the LM start, 3. polish, 4. re-check at the solution.
+    let mut verdict: Vec<Option<Verdict>> = vec![None; n_all];
+    let mut ws = Workspace::new(m, 0);
+    let mut iterations = 0;
+    let mut termination = Termination::NoFreeParameters;
+    let mut cost = initial_cost;
+    for _round in 0..3 {
+        let cols: Vec<usize> = (0..n_all).filter(|&i| free[i]).collect();
+        if cols.is_empty() {
+            break;
+        }
+        let lin = linearise(problem, &theta, &cols, &loss, &mut ws)?;
+        let v = identify(params, &lin, &opts.identify);
+        let mut changed = false;
+        for (k, vk) in v.into_iter().enumerate() {
+            if !vk.is_identified() {
+                let c = cols[k];
+                free[c] = false;
+                theta[c] = theta0[c];
+                verdict[c] = Some(vk);
+                changed = true;
+            }
+        }
+        if !changed && _round > 0 {
+            break;
+        }
+        let max_iter = opts.lm.max_iter;
+        let mut cb = |it: usize, c: f64| {
+            if let Some(p) = progress.as_mut() {
+                p(&Progress {
+                    stage,
+                    phase: Phase::Polish,
+                    iteration: it,
+                    max_iterations: max_iter,
+                    cost: c,
+                })
+            }
+        };
+        let res = lm::minimize(problem, &theta, &free, &opts.lm, Some(&mut cb))?;
+        theta = res.theta;
+        iterations += res.iterations;
+        termination = res.termination;
+        cost = res.cost;
+    }
+
+    // 5. Standard errors over the identified free set.
+    let cols: Vec<usize> = (0..n_all).filter(|&i| free[i]).collect();
+    let mut stderr = vec![None; n_all];
+    let mut residual_variance = 2.0 * cost / (m.saturating_sub(cols.len()).max(1)) as f64;
+    if !cols.is_empty() {
+        let lin = linearise(problem, &theta, &cols, &loss, &mut ws)?;
+        cost = lin.cost;
+        residual_variance = lin.wrss / (m.saturating_sub(cols.len()).max(1)) as f64;
+        let se = standard_errors(&lin, &vec![true; cols.len()]);
+        for (k, &c) in cols.iter().enumerate() {
+            stderr[c] = se[k];
+        }
+    } else {
+        problem.residuals(&theta, &mut r);
+        cost = loss.cost(&r, problem.weights());
+    }
+    let out_params = params
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let status = if let Some(v) = &verdict[i] {
+                ParamStatus::NotIdentified { reason: v.clone() }
+            } else if !free[i] {
+                ParamStatus::Fixed
+            } else if theta[i] <= p.lower || theta[i] >= p.upper {
+                ParamStatus::AtBound
+            } else {
+                ParamStatus::Fitted
+            };
+            ParamResult {
+                name: p.name.clone(),
+                start: theta0[i],
+                value: theta[i],
+                stderr: stderr[i],
+                status,
+            }
+        })
+        .collect();
+    Ok(FitOutcome {
+        stage: stage.to_string(),
+        theta,
+        params: out_params,
+        initial_cost,
+        swarm_cost,
+        cost,
+        residual_variance,
+        n_residuals: m,
+        iterations,
+        termination,
+    })
+}
+
+/// One stage of a staged fit.
+pub struct Stage<'a> {
+    pub name: String,
+    /// The stage's problem (its own data subset and residual channels).
+    pub problem: &'a dyn Problem,
+    /// Names of the parameters this stage fits; empty = the problem's `free` flags.
+    pub free: Vec<String>,
+    pub options: FitOptions,
+}
+
+/// Parameter values carried between stages, by name, in first-seen order.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ParamValues(pub Vec<(String, f64)>);
+
+impl ParamValues {
+    pub fn get(&self, name: &str) -> Option<f64> {
+        self.0.iter().find(|(n, _)| n == name).map(|(_, v)| *v)
+    }
+    pub fn set(&mut self, name: &str, value: f64) {
+        match self.0.iter_mut().find(|(n, _)| n == name) {
+            Some(e) => e.1 = value,
+            None => self.0.push((name.to_string(), value)),
+        }
+    }
+}
+
+/// Run `stages` in order. Each stage starts from `values` where they name its
+/// parameters (else from its problem's start), fits its free set, and writes
+/// its solution back into `values` for the stages after it.
+pub fn run_stages(
+    stages: &[Stage],
+    values: &mut ParamValues,
+    mut progress: Option<&mut ProgressFn>,
+) -> crate::Result<Vec<FitOutcome>> {
+    let mut out = Vec::with_capacity(stages.len());
+    for st in stages {
+        let params = st.problem.params();
+        let start: Vec<f64> = params
+            .iter()
+            .map(|p| values.get(&p.name).map_or(p.start, |v| p.clamp(v)))
+            .collect();
+        let free: Vec<bool> = if st.free.is_empty() {
+            params.iter().map(|p| p.free).collect()
+        } else {
+            for n in &st.free {
+                if !params.iter().any(|p| &p.name == n) {
+                    return Err(crate::Error::Input(format!(
+                        "fit stage '{}': unknown parameter '{n}'",
+                        st.name
+                    )));
+                }
+            }
+            params.iter().map(|p| st.free.contains(&p.name)).collect()
+        };
+        let res = fit(
+            st.problem,
+            Some(&start),
+            Some(&free),
+            &st.options,
+            &st.name,
+            progress.as_deref_mut(),
+        )?;
+        for (p, v) in params.iter().zip(&res.theta) {
+            values.set(&p.name, *v);
+        }
+        out.push(res);
+    }
+    Ok(out)
+}

@@ -1,0 +1,101 @@
+//! Particle swarm: global minimum of a multi-modal function, reproducibly;
+//! swarm + LM polish escapes the local minimum that traps LM alone.
+
+mod fit_support;
+use fit_support::*;
+use std::f64::consts::PI;
+use tyrekit::fit::{fit, pso, FitOptions, Param, Phase, PsoOptions};
+
+fn rastrigin(x: &[f64]) -> f64 {
+    10.0 * x.len() as f64
+        + x.iter()
+            .map(|v| v * v - 10.0 * (2.0 * PI * v).cos())
+            .sum::<f64>()
+}
+
+#[test]
+fn rastrigin_2d_global_minimum_reproducibly() {
+    let lo = [-5.12, -5.12];
+    let hi = [5.12, 5.12];
+    let o = PsoOptions {
+        particles: 40,
+        iterations: 300,
+        ..PsoOptions::default()
+    };
+    // Start in a local minimum far from the global one (Rastrigin has ~100 in the box).
+    let a = pso::minimize(&lo, &hi, Some(&[4.0, -3.0]), rastrigin, &o, None).unwrap();
+    let b = pso::minimize(&lo, &hi, Some(&[4.0, -3.0]), rastrigin, &o, None).unwrap();
+    assert_eq!(a, b, "same seed must give the same result");
+    // The nearest local minima (|x| = 1) have f ≈ 1; below 1e-3 means the global basin,
+    // where f ≈ 2π²·10·|x|²·… so |x| ≲ 1e-3.
+    assert!(a.cost < 1e-3, "{a:?}");
+    assert!(a.x.iter().all(|v| v.abs() < 2e-3), "{a:?}");
+    assert!(a.x.iter().zip(&lo).all(|(v, l)| v >= l));
+    // A different seed is a different (still valid) run.
+    let c = pso::minimize(
+        &lo,
+        &hi,
+        Some(&[4.0, -3.0]),
+        rastrigin,
+        &PsoOptions {
+            seed: 99,
+            ..o.clone()
+        },
+        None,
+    )
+    .unwrap();
+    assert_ne!(a.x, c.x);
+}
+
+#[test]
+fn pso_needs_finite_bounds() {
+    let r = pso::minimize(
+        &[0.0],
+        &[f64::INFINITY],
+        None,
+        |x| x[0],
+        &PsoOptions::default(),
+        None,
+    );
+    assert!(r.is_err());
+}
+
+/// y = sin(ω·t): the cost in ω has many local minima.
+fn sine_problem() -> Curve {
+    let t = linspace(0.0, 6.0, 200);
+    let y: Vec<f64> = t.iter().map(|&t| (7.3 * t).sin()).collect();
+    Curve::new(
+        vec![Param::new("omega", 1.0, 0.5, 20.0)],
+        t,
+        y,
+        |p, t| (p[0] * t).sin(),
+        |p, t, g| g[0] = t * (p[0] * t).cos(),
+    )
+}
+
+#[test]
+fn swarm_then_polish_escapes_local_minimum() {
+    let p = sine_problem();
+    let local = fit(&p, None, None, &FitOptions::default(), "lm", None).unwrap();
+    assert!(
+        (local.theta[0] - 7.3).abs() > 0.1,
+        "LM alone should be trapped: {:?}",
+        local.theta
+    );
+    let o = FitOptions {
+        pso: Some(PsoOptions::default()),
+        ..FitOptions::default()
+    };
+    let mut phases = Vec::new();
+    let mut cb = |pr: &tyrekit::fit::Progress| phases.push((pr.phase, pr.iteration, pr.cost));
+    let glob = fit(&p, None, None, &o, "pso+lm", Some(&mut cb)).unwrap();
+    // Noise-free: the polish lands on the exact frequency.
+    assert!((glob.theta[0] - 7.3).abs() < 1e-8, "{:?}", glob.theta);
+    assert!(glob.swarm_cost.unwrap() < local.cost);
+    // Progress: swarm reports first, then the polish; best cost never rises.
+    let first_polish = phases.iter().position(|p| p.0 == Phase::Polish).unwrap();
+    assert!(first_polish > 0 && phases[..first_polish].iter().all(|p| p.0 == Phase::Swarm));
+    assert!(phases
+        .windows(2)
+        .all(|w| w[0].0 != w[1].0 || w[1].2 <= w[0].2));
+}

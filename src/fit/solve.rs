@@ -173,31 +173,40 @@ pub fn fit(
         }
     }
 
-    // 2. Identifiability at the LM start, 3. polish, 4. re-check at the solution.
+    // 2. Identifiability at the LM start, 3. polish, 4. re-judge every
+    // originally free parameter at the solution: one whose column was zero
+    // only because of where the start was (e.g. a term multiplying a
+    // parameter that started at 0) is released, one that lost its effect is
+    // reset to its start; repeat until the held set is stable (≤ 4 rounds).
+    let free0 = free.clone();
     let mut verdict: Vec<Option<Verdict>> = vec![None; n_all];
     let mut ws = Workspace::new(m, 0);
     let mut iterations = 0;
     let mut termination = Termination::NoFreeParameters;
     let mut cost = initial_cost;
-    for _round in 0..3 {
-        let cols: Vec<usize> = (0..n_all).filter(|&i| free[i]).collect();
-        if cols.is_empty() {
+    let cols0: Vec<usize> = (0..n_all).filter(|&i| free0[i]).collect();
+    for round in 0..4 {
+        if cols0.is_empty() {
             break;
         }
-        let lin = linearise(problem, &theta, &cols, &loss, &mut ws)?;
+        let lin = linearise(problem, &theta, &cols0, &loss, &mut ws)?;
         let v = identify(params, &lin, &opts.identify);
-        let mut changed = false;
+        let mut held: Vec<Option<Verdict>> = vec![None; n_all];
         for (k, vk) in v.into_iter().enumerate() {
             if !vk.is_identified() {
-                let c = cols[k];
-                free[c] = false;
-                theta[c] = theta0[c];
-                verdict[c] = Some(vk);
-                changed = true;
+                held[cols0[k]] = Some(vk);
             }
         }
-        if !changed && _round > 0 {
+        let same = (0..n_all).all(|i| held[i].is_some() == verdict[i].is_some());
+        verdict = held;
+        if round > 0 && same {
             break;
+        }
+        for &c in &cols0 {
+            free[c] = verdict[c].is_none();
+            if verdict[c].is_some() {
+                theta[c] = theta0[c];
+            }
         }
         let max_iter = opts.lm.max_iter;
         let mut cb = |it: usize, c: f64| {

@@ -40,7 +40,7 @@ def model(t, alpha, fz, gamma, want_jac):
     cg = 1.0 - pdy3 * gamma ** 2
     d = mu0 * cg * fz
     u = fz / (pky2 * FZ0)
-    s2 = np.sin(2.0 * np.arctan(u))
+    s2 = 2.0 * u / (1.0 + u ** 2)  # = sin(2 atan u)
     kg = 1.0 - pky3 * np.abs(gamma)
     ky = pky1 * FZ0 * s2 * kg
     b = ky / (c * d)
@@ -76,7 +76,7 @@ def model(t, alpha, fz, gamma, want_jac):
     j[:, 6] = -dfe * e0 * sg
     j[:, 7] = -dfe * e0 * sg * gamma
     j[:, 8] = dfky * FZ0 * s2 * kg
-    j[:, 9] = dfky * pky1 * FZ0 * kg * np.cos(2.0 * np.arctan(u)) * 2.0 / (1.0 + u ** 2) * (-u / pky2)
+    j[:, 9] = dfky * pky1 * FZ0 * kg * (1.0 - u ** 2) / (1.0 + u ** 2) * 2.0 / (1.0 + u ** 2) * (-u / pky2)
     j[:, 10] = -dfky * pky1 * FZ0 * s2 * np.abs(gamma)
     j[:, 11] = dfsh
     j[:, 12] = dfsh * dfz

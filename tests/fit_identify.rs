@@ -132,3 +132,30 @@ fn strongly_correlated_but_identifiable_parameters_are_fitted() {
         out.theta
     );
 }
+
+#[test]
+fn parameter_inert_only_at_the_start_is_released_and_fitted() {
+    // y = a·exp(b·x) from a = 0: ∂y/∂b = a·x·exp(b·x) is exactly zero at the
+    // start, so b looks inert there; once a is fitted it is not, and b must be
+    // fitted too (the MF has such products, e.g. PEY3 multiplies PEY1).
+    let x = linspace(0.0, 2.0, 30);
+    let y: Vec<f64> = x.iter().map(|&x| 2.0 * (0.5 * x).exp()).collect();
+    let p = Curve::new(
+        vec![Param::unbounded("a", 0.0), Param::new("b", 0.0, -3.0, 3.0)],
+        x,
+        y,
+        |t, x| t[0] * (t[1] * x).exp(),
+        |t, x, g| {
+            g[0] = (t[1] * x).exp();
+            g[1] = t[0] * x * (t[1] * x).exp();
+        },
+    );
+    let out = fit(&p, None, None, &FitOptions::default(), "released", None).unwrap();
+    assert_eq!(out.params[1].status, ParamStatus::Fitted, "{out:?}");
+    // noise-free: the truth to solver precision
+    assert!(
+        (out.theta[0] - 2.0).abs() < 1e-8 && (out.theta[1] - 0.5).abs() < 1e-8,
+        "{:?}",
+        out.theta
+    );
+}

@@ -61,7 +61,8 @@ pub fn lateral_fy(t: &[f64], alpha: f64, fz: f64, gamma: f64, grad: Option<&mut 
     let cg = 1.0 - t[3] * gamma * gamma;
     let d = mu0 * cg * fz;
     let u = fz / (t[9] * FZ0);
-    let s2 = (2.0 * u.atan()).sin();
+    // sin(2·atan u) = 2u/(1+u²), cos(2·atan u) = (1−u²)/(1+u²)
+    let s2 = 2.0 * u / (1.0 + u * u);
     let kg = 1.0 - t[10] * gamma.abs();
     let ky = t[8] * FZ0 * s2 * kg;
     let b = ky / (c * d);
@@ -102,7 +103,8 @@ pub fn lateral_fy(t: &[f64], alpha: f64, fz: f64, gamma: f64, grad: Option<&mut 
         g[7] = -dfe * e0 * sg * gamma;
         g[8] = dfky * FZ0 * s2 * kg;
         // d sin(2 atan u)/dPKY2 = cos(2 atan u)·2/(1+u²)·(−u/PKY2)
-        g[9] = dfky * t[8] * FZ0 * kg * (2.0 * u.atan()).cos() * 2.0 / (1.0 + u * u) * (-u / t[9]);
+        g[9] = dfky * t[8] * FZ0 * kg * (1.0 - u * u) / (1.0 + u * u) * 2.0 / (1.0 + u * u)
+            * (-u / t[9]);
         g[10] = -dfky * t[8] * FZ0 * s2 * gamma.abs();
         g[11] = dfsh;
         g[12] = dfsh * dfz;
@@ -210,7 +212,12 @@ fn write_csv(path: &std::path::Path, d: &LateralData) -> crate::Result<()> {
     let io = |e| crate::Error::io(path, e);
     writeln!(w, "alpha,fz,gamma,fy").map_err(io)?;
     for i in 0..d.fy.len() {
-        writeln!(w, "{:e},{:e},{:e},{:e}", d.alpha[i], d.fz[i], d.gamma[i], d.fy[i]).map_err(io)?;
+        writeln!(
+            w,
+            "{:e},{:e},{:e},{:e}",
+            d.alpha[i], d.fz[i], d.gamma[i], d.fy[i]
+        )
+        .map_err(io)?;
     }
     w.flush().map_err(io)
 }
@@ -238,7 +245,11 @@ fn run_python(ctx: &super::BenchContext, csv: &std::path::Path) -> Result<Vec<Py
     }
     if !out.status.success() {
         let err = String::from_utf8_lossy(&out.stderr);
-        return Err(format!("{} failed: {}", script.display(), err.lines().last().unwrap_or("")));
+        return Err(format!(
+            "{} failed: {}",
+            script.display(),
+            err.lines().last().unwrap_or("")
+        ));
     }
     stdout
         .lines()
@@ -299,7 +310,11 @@ mod tests {
     /// ≈ 1e-16·|Fy|/h ≈ 1e-6 N → 1e-5 relative to the larger of the two is ample).
     #[test]
     fn stand_in_gradient_matches_finite_differences() {
-        for &(a, fz, g) in &[(0.05, 3000.0, 0.03), (-0.12, 7000.0, -0.05), (0.2, 5000.0, 0.0)] {
+        for &(a, fz, g) in &[
+            (0.05, 3000.0, 0.03),
+            (-0.12, 7000.0, -0.05),
+            (0.2, 5000.0, 0.0),
+        ] {
             let mut grad = [0.0; 18];
             lateral_fy(&TRUTH, a, fz, g, Some(&mut grad));
             for k in 0..18 {
@@ -308,9 +323,15 @@ mod tests {
                 let mut tm = TRUTH;
                 tp[k] += h;
                 tm[k] -= h;
-                let num = (lateral_fy(&tp, a, fz, g, None) - lateral_fy(&tm, a, fz, g, None)) / (2.0 * h);
+                let num =
+                    (lateral_fy(&tp, a, fz, g, None) - lateral_fy(&tm, a, fz, g, None)) / (2.0 * h);
                 let scale = num.abs().max(grad[k].abs()).max(1e-3);
-                assert!((num - grad[k]).abs() < 1e-5 * scale, "{} at α={a}: {num} vs {}", NAMES[k], grad[k]);
+                assert!(
+                    (num - grad[k]).abs() < 1e-5 * scale,
+                    "{} at α={a}: {num} vs {}",
+                    NAMES[k],
+                    grad[k]
+                );
             }
         }
     }

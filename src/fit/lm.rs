@@ -119,6 +119,22 @@ pub struct Linearisation {
     pub m: usize,
 }
 
+impl Linearisation {
+    /// The same linearisation restricted to a subset of its columns
+    /// (`keep[k]` for column k), e.g. after holding unidentified parameters.
+    pub fn restrict(&self, keep: &[bool]) -> Linearisation {
+        let idx: Vec<usize> = (0..self.cols.len()).filter(|&k| keep[k]).collect();
+        Linearisation {
+            cols: idx.iter().map(|&k| self.cols[k]).collect(),
+            a: DMatrix::from_fn(idx.len(), idx.len(), |i, j| self.a[(idx[i], idx[j])]),
+            g: DVector::from_fn(idx.len(), |i, _| self.g[idx[i]]),
+            cost: self.cost,
+            wrss: self.wrss,
+            m: self.m,
+        }
+    }
+}
+
 /// Reusable buffers (allocated once per fit, never per iteration).
 pub struct Workspace {
     r: Vec<f64>,
@@ -142,6 +158,55 @@ impl Workspace {
         if self.jac.ncols() != k {
             let m = self.r.len();
             self.jac = DMatrix::zeros(m, k);
+        }
+    }
+}
+
+/// Dot product with four independent accumulators (lets the compiler
+/// vectorise; the summation order is fixed, so results are reproducible).
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0f64; 4];
+    let ca = a.chunks_exact(4);
+    let cb = b.chunks_exact(4);
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for l in 0..4 {
+            acc[l] += x[l] * y[l];
+        }
+    }
+    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+    for (x, y) in ra.iter().zip(rb) {
+        s += x * y;
+    }
+    s
+}
+
+/// A = JᵀJ and g = Jᵀr for a column-major m×k `jac`: only the upper
+/// triangle is computed (then mirrored), over row blocks small enough that
+/// the k column pieces stay in cache while all k(k+1)/2 products are taken.
+/// Half the products of `jac.tr_mul(&jac)`, and no m-sized temporaries.
+pub fn gram(jac: &DMatrix<f64>, r: &[f64], a: &mut DMatrix<f64>, g: &mut DVector<f64>) {
+    const BLOCK: usize = 2048;
+    let (m, k) = jac.shape();
+    a.fill(0.0);
+    g.fill(0.0);
+    let data = jac.as_slice();
+    let mut start = 0;
+    while start < m {
+        let end = (start + BLOCK).min(m);
+        for p in 0..k {
+            let cp = &data[p * m + start..p * m + end];
+            for q in p..k {
+                a[(p, q)] += dot(cp, &data[q * m + start..q * m + end]);
+            }
+            g[p] += dot(cp, &r[start..end]);
+        }
+        start = end;
+    }
+    for p in 0..k {
+        for q in 0..p {
+            a[(p, q)] = a[(q, p)];
         }
     }
 }
@@ -182,23 +247,30 @@ pub fn linearise(
             "fit: the residuals are not finite at the current parameters".into(),
         ));
     }
-    for j in 0..k {
-        let mut col = ws.jac.column_mut(j);
+    // Row scaling by √ω (skipped when every ω is 1: plain, unweighted LS).
+    let unit = w.is_none() && loss.kind == super::loss::LossKind::Linear;
+    if unit {
+        ws.r_trial.copy_from_slice(&ws.r);
+    } else {
+        for j in 0..k {
+            let mut col = ws.jac.column_mut(j);
+            for i in 0..m {
+                col[i] *= ws.sw[i];
+            }
+        }
         for i in 0..m {
-            col[i] *= ws.sw[i];
+            ws.r_trial[i] = ws.r[i] * ws.sw[i];
         }
     }
-    if ws.jac.iter().any(|x| !x.is_finite()) {
+    let mut a = DMatrix::zeros(k, k);
+    let mut g = DVector::zeros(k);
+    gram(&ws.jac, &ws.r_trial, &mut a, &mut g);
+    // A non-finite Jacobian entry makes its column's diagonal non-finite.
+    if (0..k).any(|j| !a[(j, j)].is_finite() || !g[j].is_finite()) {
         return Err(crate::Error::Numeric(
             "fit: the Jacobian is not finite at the current parameters".into(),
         ));
     }
-    for i in 0..m {
-        ws.r_trial[i] = ws.r[i] * ws.sw[i];
-    }
-    let a = ws.jac.tr_mul(&ws.jac);
-    let rt = DVector::from_column_slice(&ws.r_trial);
-    let g = ws.jac.tr_mul(&rt);
     Ok(Linearisation {
         cols: cols.to_vec(),
         a,
@@ -217,9 +289,40 @@ pub fn minimize(
     theta0: &[f64],
     free: &[bool],
     opts: &LmOptions,
+    progress: Option<&mut dyn FnMut(usize, f64)>,
+) -> crate::Result<LmResult> {
+    let m = problem.n_residuals();
+    minimize_from(
+        problem,
+        theta0,
+        free,
+        opts,
+        None,
+        &mut Workspace::new(m, 0),
+        progress,
+    )
+}
+
+/// [`minimize`] with a caller-owned workspace and, optionally, the
+/// linearisation at `theta0` over exactly the free columns (saves one
+/// Jacobian evaluation when the caller already has it).
+pub fn minimize_from(
+    problem: &dyn Problem,
+    theta0: &[f64],
+    free: &[bool],
+    opts: &LmOptions,
+    start: Option<Linearisation>,
+    ws: &mut Workspace,
     mut progress: Option<&mut dyn FnMut(usize, f64)>,
 ) -> crate::Result<LmResult> {
     super::problem::validate(problem, theta0)?;
+    if free.len() != theta0.len() {
+        return Err(crate::Error::Input(format!(
+            "fit: free mask of length {} for {} parameters",
+            free.len(),
+            theta0.len()
+        )));
+    }
     let params = problem.params();
     let cols: Vec<usize> = (0..params.len()).filter(|&i| free[i]).collect();
     let m = problem.n_residuals();
@@ -227,7 +330,9 @@ pub fn minimize(
     let mut theta = theta0.to_vec();
     let w = problem.weights();
     let loss = &opts.loss;
-    let mut ws = Workspace::new(m, n);
+    if ws.r.len() != m {
+        *ws = Workspace::new(m, n);
+    }
     if n == 0 || m == 0 {
         problem.residuals(&theta, &mut ws.r);
         let cost = cost_of(loss, &ws.r, w);
@@ -243,7 +348,10 @@ pub fn minimize(
     let lower: Vec<f64> = cols.iter().map(|&c| params[c].lower).collect();
     let upper: Vec<f64> = cols.iter().map(|&c| params[c].upper).collect();
 
-    let mut lin = linearise(problem, &theta, &cols, loss, &mut ws)?;
+    let mut lin = match start {
+        Some(l) if l.cols == cols && l.m == m => l,
+        _ => linearise(problem, &theta, &cols, loss, ws)?,
+    };
     let initial_cost = lin.cost;
     let mut cost = lin.cost;
     let mut diag = vec![0.0f64; n];
@@ -349,7 +457,7 @@ pub fn minimize(
                 if iterations >= opts.max_iter {
                     break 'outer Termination::MaxIterations;
                 }
-                lin = linearise(problem, &theta, &cols, loss, &mut ws)?;
+                lin = linearise(problem, &theta, &cols, loss, ws)?;
                 cost = lin.cost;
                 continue 'outer;
             }

@@ -185,6 +185,8 @@ pub fn fit(
     let mut termination = Termination::NoFreeParameters;
     let mut cost = initial_cost;
     let cols0: Vec<usize> = (0..n_all).filter(|&i| free0[i]).collect();
+    // Linearisation over cols0 valid at the current θ, if any.
+    let mut current: Option<super::lm::Linearisation> = None;
     for round in 0..4 {
         if cols0.is_empty() {
             break;
@@ -200,14 +202,20 @@ pub fn fit(
         let same = (0..n_all).all(|i| held[i].is_some() == verdict[i].is_some());
         verdict = held;
         if round > 0 && same {
+            current = Some(lin);
             break;
         }
+        let mut moved = false;
         for &c in &cols0 {
             free[c] = verdict[c].is_none();
-            if verdict[c].is_some() {
+            if verdict[c].is_some() && theta[c] != theta0[c] {
                 theta[c] = theta0[c];
+                moved = true;
             }
         }
+        // Reuse the linearisation unless holding a parameter moved θ.
+        let keep: Vec<bool> = cols0.iter().map(|&c| free[c]).collect();
+        let start_lin = (!moved).then(|| lin.restrict(&keep));
         let max_iter = opts.lm.max_iter;
         let mut cb = |it: usize, c: f64| {
             if let Some(p) = progress.as_mut() {
@@ -220,7 +228,15 @@ pub fn fit(
                 })
             }
         };
-        let res = lm::minimize(problem, &theta, &free, &opts.lm, Some(&mut cb))?;
+        let res = lm::minimize_from(
+            problem,
+            &theta,
+            &free,
+            &opts.lm,
+            start_lin,
+            &mut ws,
+            Some(&mut cb),
+        )?;
         theta = res.theta;
         iterations += res.iterations;
         termination = res.termination;
@@ -228,15 +244,19 @@ pub fn fit(
     }
 
     // 5. Standard errors over the identified free set.
-    let cols: Vec<usize> = (0..n_all).filter(|&i| free[i]).collect();
     let mut stderr = vec![None; n_all];
-    let mut residual_variance = 2.0 * cost / (m.saturating_sub(cols.len()).max(1)) as f64;
-    if !cols.is_empty() {
-        let lin = linearise(problem, &theta, &cols, &loss, &mut ws)?;
+    let n_free = (0..n_all).filter(|&i| free[i]).count();
+    let mut residual_variance = 2.0 * cost / (m.saturating_sub(n_free).max(1)) as f64;
+    if !cols0.is_empty() {
+        let lin = match current {
+            Some(l) => l,
+            None => linearise(problem, &theta, &cols0, &loss, &mut ws)?,
+        };
         cost = lin.cost;
-        residual_variance = lin.wrss / (m.saturating_sub(cols.len()).max(1)) as f64;
-        let se = standard_errors(&lin, &vec![true; cols.len()]);
-        for (k, &c) in cols.iter().enumerate() {
+        residual_variance = lin.wrss / (m.saturating_sub(n_free).max(1)) as f64;
+        let keep: Vec<bool> = cols0.iter().map(|&c| free[c]).collect();
+        let se = standard_errors(&lin, &keep);
+        for (k, &c) in cols0.iter().enumerate() {
             stderr[c] = se[k];
         }
     } else {

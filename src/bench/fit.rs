@@ -267,9 +267,18 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
     write_csv(&csv, &data)?;
     let problem = LateralStandIn::new(data);
     let opts = FitOptions::default();
-    let t0 = Instant::now();
-    let out = fit(&problem, None, None, &opts, "pure Fy", None)?;
-    let ours = t0.elapsed().as_secs_f64();
+    // Best of 3 (the fit is deterministic, so every repeat does the same work;
+    // the minimum is the figure least disturbed by other load on the machine).
+    let repeats = if ctx.quick { 1 } else { 3 };
+    let mut ours = f64::INFINITY;
+    let mut out = None;
+    for _ in 0..repeats {
+        let t0 = Instant::now();
+        let o = fit(&problem, None, None, &opts, "pure Fy", None)?;
+        ours = ours.min(t0.elapsed().as_secs_f64());
+        out = Some(o);
+    }
+    let out = out.ok_or_else(|| crate::Error::Other("bench fit: no run".into()))?;
     let worst = out
         .theta
         .iter()
@@ -278,20 +287,20 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
         .map(|((v, t), p)| (v - t).abs() / p.stderr.unwrap_or(f64::NAN))
         .fold(0.0, f64::max);
     println!(
-        "  tyrekit LM    {:>8.3} s  cost {:.6e}  iterations {:>3}  ({:?}; worst |θ − truth| = {:.1} std. errors)",
+        "  tyrekit LM    {:>8.3} s  cost {:.9e}  iterations {:>3}  ({:?}; worst |θ − truth| = {:.1} std. errors)",
         ours, out.cost, out.iterations, out.termination, worst
     );
     match run_python(ctx, &csv) {
         Ok(rs) => {
             for r in rs {
                 println!(
-                    "  SciPy {:<7} {:>8.3} s  cost {:.6e}  nfev {:>4}   tyrekit is {:.1}x faster, cost ratio (SciPy/tyrekit) {:.6}",
+                    "  SciPy {:<7} {:>8.3} s  cost {:.9e}  nfev {:>4}  tyrekit {:.1}x faster; cost SciPy/tyrekit − 1 = {:+.1e}",
                     r.method,
                     r.seconds,
                     r.cost,
                     r.nfev,
                     r.seconds / ours,
-                    r.cost / out.cost
+                    r.cost / out.cost - 1.0
                 );
             }
         }

@@ -99,3 +99,26 @@ fn swarm_then_polish_escapes_local_minimum() {
         .windows(2)
         .all(|w| w[0].0 != w[1].0 || w[1].2 <= w[0].2));
 }
+
+#[test]
+fn swarm_on_a_subsample_then_polish_on_all_data() {
+    // The swarm sees every 10th sample only; the polish uses all of them.
+    let full = sine_problem();
+    let sub = Curve::new(
+        full.params.clone(),
+        full.x.iter().step_by(10).cloned().collect(),
+        full.y.iter().step_by(10).cloned().collect(),
+        full.model,
+        full.grad,
+    );
+    let o = FitOptions {
+        pso: Some(PsoOptions::default()),
+        ..FitOptions::default()
+    };
+    let out = tyrekit::fit::fit_global(&full, Some(&sub), None, None, &o, "sub", None).unwrap();
+    assert!((out.theta[0] - 7.3).abs() < 1e-8, "{:?}", out.theta);
+    // every swarm evaluation went to the subsample: the full problem saw only the polish
+    let polish_evals = full.seen.borrow().len();
+    assert!(polish_evals < 100, "{polish_evals}");
+    assert!(sub.seen.borrow().len() > 1000);
+}

@@ -27,12 +27,14 @@ fn stages_pass_values_on() {
             problem: &s1,
             free: vec!["a".into()],
             options: FitOptions::default(),
+            swarm_problem: None,
         },
         Stage {
             name: "slope".into(),
             problem: &s2,
             free: vec!["b".into()],
             options: FitOptions::default(),
+            swarm_problem: None,
         },
     ];
     let mut values = ParamValues::default();
@@ -53,6 +55,7 @@ fn unknown_stage_parameter_is_an_error() {
         problem: &s1,
         free: vec!["pdy1".into()],
         options: FitOptions::default(),
+        swarm_problem: None,
     }];
     let e = run_stages(&stages, &mut ParamValues::default(), None).unwrap_err();
     assert!(e.to_string().contains("pdy1"), "{e}");

@@ -29,6 +29,6 @@ pub use problem::{Param, Problem};
 pub use pso::PsoOptions;
 pub use report::FitReport;
 pub use solve::{
-    fit, run_stages, FitOptions, FitOutcome, ParamResult, ParamStatus, ParamValues, Phase,
-    Progress, ProgressFn, Stage,
+    fit, fit_global, run_stages, FitOptions, FitOutcome, ParamResult, ParamStatus, ParamValues,
+    Phase, Progress, ProgressFn, Stage,
 };

@@ -99,8 +99,25 @@ impl FitOutcome {
 
 /// Fit `problem` from `start` (None: the problem's start values) over the
 /// parameters marked in `free` (None: the problem's `free` flags).
+/// The swarm (if `opts.pso` is set) runs on `problem` itself; see
+/// [`fit_global`] to run it on a cheaper subsample.
 pub fn fit(
     problem: &dyn Problem,
+    start: Option<&[f64]>,
+    free: Option<&[bool]>,
+    opts: &FitOptions,
+    stage: &str,
+    progress: Option<&mut ProgressFn>,
+) -> crate::Result<FitOutcome> {
+    fit_global(problem, None, start, free, opts, stage, progress)
+}
+
+/// [`fit`] with the swarm run on `swarm_problem` (same parameter table, e.g.
+/// every 20th sample: the swarm needs thousands of cost evaluations, the
+/// polish a dozen). `FitOutcome::swarm_cost` is then that problem's cost.
+pub fn fit_global(
+    problem: &dyn Problem,
+    swarm_problem: Option<&dyn Problem>,
     start: Option<&[f64]>,
     free: Option<&[bool]>,
     opts: &FitOptions,
@@ -108,6 +125,18 @@ pub fn fit(
     mut progress: Option<&mut ProgressFn>,
 ) -> crate::Result<FitOutcome> {
     let params = problem.params();
+    let swarm_problem = swarm_problem.unwrap_or(problem);
+    let same_table = swarm_problem.params().len() == params.len()
+        && swarm_problem
+            .params()
+            .iter()
+            .zip(params)
+            .all(|(a, b)| a.name == b.name);
+    if !same_table {
+        return Err(crate::Error::Input(format!(
+            "fit stage '{stage}': the swarm problem's parameters differ from the problem's"
+        )));
+    }
     let theta0: Vec<f64> = match start {
         Some(s) => s.to_vec(),
         None => params.iter().map(|p| p.start).collect(),
@@ -141,6 +170,7 @@ pub fn fit(
             let hi: Vec<f64> = cols.iter().map(|&c| params[c].upper).collect();
             let x0: Vec<f64> = cols.iter().map(|&c| theta0[c]).collect();
             let mut th = theta0.clone();
+            let mut rs = vec![0.0; swarm_problem.n_residuals()];
             let mut cb = |it: usize, c: f64| {
                 if let Some(p) = progress.as_mut() {
                     p(&Progress {
@@ -160,8 +190,8 @@ pub fn fit(
                     for (k, &c) in cols.iter().enumerate() {
                         th[c] = x[k];
                     }
-                    problem.residuals(&th, &mut r);
-                    loss.cost(&r, problem.weights())
+                    swarm_problem.residuals(&th, &mut rs);
+                    loss.cost(&rs, swarm_problem.weights())
                 },
                 po,
                 Some(&mut cb),
@@ -307,6 +337,8 @@ pub struct Stage<'a> {
     /// Names of the parameters this stage fits; empty = the problem's `free` flags.
     pub free: Vec<String>,
     pub options: FitOptions,
+    /// Problem the swarm runs on (a subsample of `problem`); `None` = `problem`.
+    pub swarm_problem: Option<&'a dyn Problem>,
 }
 
 /// Parameter values carried between stages, by name, in first-seen order.
@@ -353,8 +385,9 @@ pub fn run_stages(
             }
             params.iter().map(|p| st.free.contains(&p.name)).collect()
         };
-        let res = fit(
+        let res = fit_global(
             st.problem,
+            st.swarm_problem,
             Some(&start),
             Some(&free),
             &st.options,

@@ -87,17 +87,20 @@ fn swarm_then_polish_escapes_local_minimum() {
         ..FitOptions::default()
     };
     let mut phases = Vec::new();
-    let mut cb = |pr: &tyrekit::fit::Progress| phases.push((pr.phase, pr.iteration, pr.cost));
+    let mut cb = |pr: &tyrekit::fit::Progress| phases.push((pr.phase, pr.candidate, pr.cost));
     let glob = fit(&p, None, None, &o, "pso+lm", Some(&mut cb)).unwrap();
     // Noise-free: the polish lands on the exact frequency.
     assert!((glob.theta[0] - 7.3).abs() < 1e-8, "{:?}", glob.theta);
     assert!(glob.swarm_cost.unwrap() < local.cost);
-    // Progress: swarm reports first, then the polish; best cost never rises.
+    // Progress: swarm reports first, then the polish of each candidate start;
+    // within one phase and candidate the reported cost never rises.
     let first_polish = phases.iter().position(|p| p.0 == Phase::Polish).unwrap();
     assert!(first_polish > 0 && phases[..first_polish].iter().all(|p| p.0 == Phase::Swarm));
     assert!(phases
         .windows(2)
-        .all(|w| w[0].0 != w[1].0 || w[1].2 <= w[0].2));
+        .all(|w| (w[0].0, w[0].1) != (w[1].0, w[1].1) || w[1].2 <= w[0].2));
+    // two swarm candidates (PsoOptions::polish = 2) plus the start
+    assert_eq!(phases.iter().map(|p| p.1).max(), Some(2));
 }
 
 #[test]

@@ -148,9 +148,9 @@ impl LateralData {
                     if d.alpha.len() == n {
                         break 'o;
                     }
-                    // triangle sweep −0.25 → +0.25 → −0.25
+                    // triangle sweep +0.25 → −0.25 → +0.25 rad
                     let ph = i as f64 / per as f64;
-                    let a = 0.25 * (1.0 - 4.0 * (ph - 0.5).abs()) * -1.0;
+                    let a = -0.25 * (1.0 - 4.0 * (ph - 0.5).abs());
                     // Box–Muller
                     let (u1, u2): (f64, f64) = (rng.gen::<f64>().max(1e-300), rng.gen());
                     let z = (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos();
@@ -307,6 +307,31 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
         Err(e) => println!("  SciPy: skipped: {e}"),
     }
     let _ = std::fs::remove_file(&csv);
+
+    // Global start: swarm on every 20th sample, then the LM polish on all.
+    let sub = LateralStandIn::new(LateralData {
+        alpha: problem.data.alpha.iter().step_by(20).cloned().collect(),
+        fz: problem.data.fz.iter().step_by(20).cloned().collect(),
+        gamma: problem.data.gamma.iter().step_by(20).cloned().collect(),
+        fy: problem.data.fy.iter().step_by(20).cloned().collect(),
+    });
+    let gopts = FitOptions {
+        pso: Some(crate::fit::PsoOptions {
+            iterations: if ctx.quick { 30 } else { 150 },
+            ..Default::default()
+        }),
+        ..FitOptions::default()
+    };
+    let t0 = Instant::now();
+    let g = crate::fit::fit_global(&problem, Some(&sub), None, None, &gopts, "pure Fy", None)?;
+    println!(
+        "  tyrekit PSO({} particles, {} samples) + LM  {:>6.3} s  cost {:.9e}  iterations {:>3}",
+        gopts.pso.as_ref().map_or(0, |p| p.particles),
+        sub.data.fy.len(),
+        t0.elapsed().as_secs_f64(),
+        g.cost,
+        g.iterations
+    );
     Ok(())
 }
 

@@ -29,6 +29,9 @@ pub struct PsoOptions {
     /// Stop after this many iterations without improving the best cost by
     /// more than `1e-12 × |best|` (0 = never stop early).
     pub patience: usize,
+    /// How many of the swarm's best distinct points the fit polishes by LM
+    /// (the given start is always polished too; the lowest final cost wins).
+    pub polish: usize,
 }
 
 impl Default for PsoOptions {
@@ -42,6 +45,7 @@ impl Default for PsoOptions {
             social: 1.49618,
             vmax_fraction: 0.5,
             patience: 40,
+            polish: 2,
         }
     }
 }
@@ -50,6 +54,9 @@ impl Default for PsoOptions {
 #[derive(Clone, Debug, PartialEq)]
 pub struct PsoResult {
     pub x: Vec<f64>,
+    /// The particles' personal bests, best first, without duplicates
+    /// (`candidates[0] == x`).
+    pub candidates: Vec<Vec<f64>>,
     pub cost: f64,
     pub evaluations: usize,
     pub iterations: usize,
@@ -157,7 +164,16 @@ pub fn minimize(
             }
         }
     }
+    let mut order: Vec<usize> = (0..np).collect();
+    order.sort_by(|&a, &b| pcost[a].total_cmp(&pcost[b]).then(a.cmp(&b)));
+    let mut candidates: Vec<Vec<f64>> = vec![gbest.clone()];
+    for p in order {
+        if !candidates.iter().any(|c| c == &pbest[p]) {
+            candidates.push(pbest[p].clone());
+        }
+    }
     Ok(PsoResult {
+        candidates,
         x: gbest,
         cost: gcost,
         evaluations,

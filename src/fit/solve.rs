@@ -35,7 +35,10 @@ pub struct Progress<'a> {
     /// Iteration within the phase, and its upper limit.
     pub iteration: usize,
     pub max_iterations: usize,
-    /// Best cost so far.
+    /// Which start is being polished (0-based), of how many (1 without a swarm).
+    pub candidate: usize,
+    pub candidates: usize,
+    /// Best cost so far (within this phase and candidate).
     pub cost: f64,
 }
 
@@ -142,7 +145,7 @@ pub fn fit_global(
         None => params.iter().map(|p| p.start).collect(),
     };
     validate(problem, &theta0)?;
-    let mut free: Vec<bool> = match free {
+    let free_in: Vec<bool> = match free {
         Some(f) if f.len() == params.len() => f.to_vec(),
         Some(f) => {
             return Err(crate::Error::Input(format!(
@@ -160,11 +163,11 @@ pub fn fit_global(
     problem.residuals(&theta0, &mut r);
     let initial_cost = loss.cost(&r, problem.weights());
 
-    // 1. Global start.
-    let mut theta = theta0.clone();
+    // 1. Global start: the swarm's best distinct points, then the given start.
+    let mut starts: Vec<Vec<f64>> = Vec::new();
     let mut swarm_cost = None;
     if let Some(po) = &opts.pso {
-        let cols: Vec<usize> = (0..n_all).filter(|&i| free[i]).collect();
+        let cols: Vec<usize> = (0..n_all).filter(|&i| free_in[i]).collect();
         if !cols.is_empty() {
             let lo: Vec<f64> = cols.iter().map(|&c| params[c].lower).collect();
             let hi: Vec<f64> = cols.iter().map(|&c| params[c].upper).collect();
@@ -178,6 +181,8 @@ pub fn fit_global(
                         phase: Phase::Swarm,
                         iteration: it,
                         max_iterations: po.iterations,
+                        candidate: 0,
+                        candidates: 1,
                         cost: c,
                     })
                 }
@@ -196,82 +201,52 @@ pub fn fit_global(
                 po,
                 Some(&mut cb),
             )?;
-            for (k, &c) in cols.iter().enumerate() {
-                theta[c] = res.x[k];
+            for x in res.candidates.iter().take(po.polish.max(1)) {
+                let mut t = theta0.clone();
+                for (k, &c) in cols.iter().enumerate() {
+                    t[c] = x[k];
+                }
+                starts.push(t);
             }
             swarm_cost = Some(res.cost);
         }
     }
 
-    // 2. Identifiability at the LM start, 3. polish, 4. re-judge every
-    // originally free parameter at the solution: one whose column was zero
-    // only because of where the start was (e.g. a term multiplying a
-    // parameter that started at 0) is released, one that lost its effect is
-    // reset to its start; repeat until the held set is stable (≤ 4 rounds).
-    let free0 = free.clone();
-    let mut verdict: Vec<Option<Verdict>> = vec![None; n_all];
-    let mut ws = Workspace::new(m, 0);
-    let mut iterations = 0;
-    let mut termination = Termination::NoFreeParameters;
-    let mut cost = initial_cost;
-    let cols0: Vec<usize> = (0..n_all).filter(|&i| free0[i]).collect();
-    // Linearisation over cols0 valid at the current θ, if any.
-    let mut current: Option<super::lm::Linearisation> = None;
-    for round in 0..4 {
-        if cols0.is_empty() {
-            break;
-        }
-        let lin = linearise(problem, &theta, &cols0, &loss, &mut ws)?;
-        let v = identify(params, &lin, &opts.identify);
-        let mut held: Vec<Option<Verdict>> = vec![None; n_all];
-        for (k, vk) in v.into_iter().enumerate() {
-            if !vk.is_identified() {
-                held[cols0[k]] = Some(vk);
-            }
-        }
-        let same = (0..n_all).all(|i| held[i].is_some() == verdict[i].is_some());
-        verdict = held;
-        if round > 0 && same {
-            current = Some(lin);
-            break;
-        }
-        let mut moved = false;
-        for &c in &cols0 {
-            free[c] = verdict[c].is_none();
-            if verdict[c].is_some() && theta[c] != theta0[c] {
-                theta[c] = theta0[c];
-                moved = true;
-            }
-        }
-        // Reuse the linearisation unless holding a parameter moved θ.
-        let keep: Vec<bool> = cols0.iter().map(|&c| free[c]).collect();
-        let start_lin = (!moved).then(|| lin.restrict(&keep));
-        let max_iter = opts.lm.max_iter;
-        let mut cb = |it: usize, c: f64| {
-            if let Some(p) = progress.as_mut() {
-                p(&Progress {
-                    stage,
-                    phase: Phase::Polish,
-                    iteration: it,
-                    max_iterations: max_iter,
-                    cost: c,
-                })
-            }
-        };
-        let res = lm::minimize_from(
-            problem,
-            &theta,
-            &free,
-            &opts.lm,
-            start_lin,
-            &mut ws,
-            Some(&mut cb),
-        )?;
-        theta = res.theta;
-        iterations += res.iterations;
-        termination = res.termination;
-        cost = res.cost;
+    // 2–4. Polish every candidate start; keep the lowest final cost (ties: the
+    // earlier candidate, so the swarm's best wins over the user's start).
+    if !starts.contains(&theta0) {
+        starts.push(theta0.clone());
     }
+    let mut ws = Workspace::new(m, 0);
+    let mut best: Option<Polished> = None;
+    let n_starts = starts.len();
+    for (which, cand) in starts.into_iter().enumerate() {
+        let p = polish(
+            problem,
+            cand,
+            (which, n_starts),
+            &theta0,
+            &free_in,
+            opts,
+            stage,
+            progress.as_deref_mut(),
+            &mut ws,
+        )?;
+        if best.as_ref().is_none_or(|b| p.cost < b.cost) {
+            best = Some(p);
+        }
+    }
+    let best = best.ok_or_else(|| crate::Error::Numeric("fit: no start to polish".into()))?;
+    let Polished {
+        theta,
+        free,
+        verdict,
+        current,
+        iterations,
+        termination,
+        mut cost,
+    } = best;
+    let cols0: Vec<usize> = (0..n_all).filter(|&i| free_in[i]).collect();
 
     // 5. Standard errors over the identified free set.
     let mut stderr = vec![None; n_all];
@@ -326,6 +301,122 @@ pub fn fit_global(
         n_residuals: m,
         iterations,
         termination,
+    })
+}
+
+/// A polished candidate.
+struct Polished {
+    theta: Vec<f64>,
+    free: Vec<bool>,
+    verdict: Vec<Option<Verdict>>,
+    /// Linearisation over the originally free columns at `theta`, if current.
+    current: Option<super::lm::Linearisation>,
+    iterations: usize,
+    termination: Termination,
+    cost: f64,
+}
+
+/// Identify, polish by LM and re-judge from one start (see `fit_global`).
+#[allow(clippy::too_many_arguments)]
+fn polish(
+    problem: &dyn Problem,
+    theta_init: Vec<f64>,
+    which: (usize, usize),
+    theta0: &[f64],
+    free0: &[bool],
+    opts: &FitOptions,
+    stage: &str,
+    mut progress: Option<&mut ProgressFn>,
+    ws: &mut Workspace,
+) -> crate::Result<Polished> {
+    // 2. Identifiability at the LM start, 3. polish, 4. re-judge every
+    // originally free parameter at the solution: one whose column was zero
+    // only because of where the start was (e.g. a term multiplying a
+    // parameter that started at 0) is released, one that lost its effect is
+    // reset to its start; repeat until the held set is stable (≤ 4 rounds).
+    let params = problem.params();
+    let n_all = params.len();
+    let loss = opts.lm.loss;
+    let mut theta = theta_init;
+    let mut free = free0.to_vec();
+    let mut verdict: Vec<Option<Verdict>> = vec![None; n_all];
+    let mut iterations = 0;
+    let mut termination = Termination::NoFreeParameters;
+    let mut cost = f64::INFINITY;
+    let cols0: Vec<usize> = (0..n_all).filter(|&i| free0[i]).collect();
+    // Linearisation over cols0 valid at the current θ, if any.
+    let mut current: Option<super::lm::Linearisation> = None;
+    for round in 0..4 {
+        if cols0.is_empty() {
+            break;
+        }
+        let lin = linearise(problem, &theta, &cols0, &loss, ws)?;
+        let v = identify(params, &lin, &opts.identify);
+        let mut held: Vec<Option<Verdict>> = vec![None; n_all];
+        for (k, vk) in v.into_iter().enumerate() {
+            if !vk.is_identified() {
+                held[cols0[k]] = Some(vk);
+            }
+        }
+        let same = (0..n_all).all(|i| held[i].is_some() == verdict[i].is_some());
+        verdict = held;
+        if round > 0 && same {
+            current = Some(lin);
+            break;
+        }
+        let mut moved = false;
+        for &c in &cols0 {
+            free[c] = verdict[c].is_none();
+            if verdict[c].is_some() && theta[c] != theta0[c] {
+                theta[c] = theta0[c];
+                moved = true;
+            }
+        }
+        // Reuse the linearisation unless holding a parameter moved θ.
+        let keep: Vec<bool> = cols0.iter().map(|&c| free[c]).collect();
+        let start_lin = (!moved).then(|| lin.restrict(&keep));
+        let max_iter = opts.lm.max_iter;
+        let mut cb = |it: usize, c: f64| {
+            if let Some(p) = progress.as_mut() {
+                p(&Progress {
+                    stage,
+                    phase: Phase::Polish,
+                    iteration: it,
+                    max_iterations: max_iter,
+                    candidate: which.0,
+                    candidates: which.1,
+                    cost: c,
+                })
+            }
+        };
+        let res = lm::minimize_from(
+            problem,
+            &theta,
+            &free,
+            &opts.lm,
+            start_lin,
+            ws,
+            Some(&mut cb),
+        )?;
+        theta = res.theta;
+        iterations += res.iterations;
+        termination = res.termination;
+        cost = res.cost;
+    }
+
+    if cost == f64::INFINITY {
+        let mut r = vec![0.0; problem.n_residuals()];
+        problem.residuals(&theta, &mut r);
+        cost = loss.cost(&r, problem.weights());
+    }
+    Ok(Polished {
+        theta,
+        free,
+        verdict,
+        current,
+        iterations,
+        termination,
+        cost,
     })
 }
 

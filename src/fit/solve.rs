@@ -333,7 +333,11 @@ fn polish(
     // originally free parameter at the solution: one whose column was zero
     // only because of where the start was (e.g. a term multiplying a
     // parameter that started at 0) is released, one that lost its effect is
-    // reset to its start; repeat until the held set is stable (≤ 4 rounds).
+    // reset to its start; repeat until the held set is stable (≤ 5 rounds).
+    // While some parameter is held for the first time the LM runs to a loose
+    // tolerance (1e-6): its solution is only where the held set is re-judged,
+    // and converging the reduced model fully would be wasted work. The last
+    // run is always at the caller's tolerances.
     let params = problem.params();
     let n_all = params.len();
     let loss = opts.lm.loss;
@@ -346,7 +350,8 @@ fn polish(
     let cols0: Vec<usize> = (0..n_all).filter(|&i| free0[i]).collect();
     // Linearisation over cols0 valid at the current θ, if any.
     let mut current: Option<super::lm::Linearisation> = None;
-    for round in 0..4 {
+    let mut last_loose = false;
+    for round in 0..5 {
         if cols0.is_empty() {
             break;
         }
@@ -360,10 +365,18 @@ fn polish(
         }
         let same = (0..n_all).all(|i| held[i].is_some() == verdict[i].is_some());
         verdict = held;
-        if round > 0 && same {
+        if round > 0 && same && !last_loose {
             current = Some(lin);
             break;
         }
+        let loose = verdict.iter().any(|v| v.is_some()) && !(round > 0 && same) && round < 4;
+        let mut lm_opts = opts.lm.clone();
+        if loose {
+            lm_opts.ftol = lm_opts.ftol.max(1e-6);
+            lm_opts.xtol = lm_opts.xtol.max(1e-6);
+            lm_opts.gtol = lm_opts.gtol.max(1e-6);
+        }
+        last_loose = loose;
         let mut moved = false;
         for &c in &cols0 {
             free[c] = verdict[c].is_none();
@@ -393,7 +406,7 @@ fn polish(
             problem,
             &theta,
             &free,
-            &opts.lm,
+            &lm_opts,
             start_lin,
             ws,
             Some(&mut cb),

@@ -4,7 +4,7 @@
 
 mod fit_support;
 use fit_support::*;
-use nalgebra::DMatrix;
+use nalgebra::DMatrixViewMut;
 use tyrekit::fit::{fit, lm, FitOptions, LmOptions, Loss, LossKind, Param, ParamStatus, Problem};
 
 /// Rosenbrock as least squares: r = (10(y − x²), 1 − x), minimum 0 at (1, 1).
@@ -20,7 +20,7 @@ impl Problem for Rosenbrock {
         r[0] = 10.0 * (t[1] - t[0] * t[0]);
         r[1] = 1.0 - t[0];
     }
-    fn jacobian(&self, t: &[f64], cols: &[usize], r: &mut [f64], jac: &mut DMatrix<f64>) {
+    fn jacobian(&self, t: &[f64], cols: &[usize], r: &mut [f64], jac: &mut DMatrixViewMut<f64>) {
         self.residuals(t, r);
         let full = [[-20.0 * t[0], 10.0], [-1.0, 0.0]];
         for (k, &c) in cols.iter().enumerate() {

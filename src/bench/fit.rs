@@ -22,7 +22,7 @@
 //! Must never: assert on timings, or be mistaken for the real MF.
 
 use crate::fit::{fit, FitOptions, Param, Problem};
-use nalgebra::DMatrix;
+use nalgebra::DMatrixViewMut;
 use rand::{Rng, SeedableRng};
 use std::time::Instant;
 
@@ -193,7 +193,13 @@ impl Problem for LateralStandIn {
             r[i] = lateral_fy(theta, d.alpha[i], d.fz[i], d.gamma[i], None) - d.fy[i];
         }
     }
-    fn jacobian(&self, theta: &[f64], cols: &[usize], r: &mut [f64], jac: &mut DMatrix<f64>) {
+    fn jacobian(
+        &self,
+        theta: &[f64],
+        cols: &[usize],
+        r: &mut [f64],
+        jac: &mut DMatrixViewMut<f64>,
+    ) {
         let d = &self.data;
         let mut g = [0.0; 18];
         for i in 0..d.fy.len() {

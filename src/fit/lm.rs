@@ -232,7 +232,7 @@ pub fn linearise(
     let m = problem.n_residuals();
     let k = cols.len();
     ws.ensure_cols(k);
-    problem.jacobian(theta, cols, &mut ws.r, &mut ws.jac);
+    problem.jacobian(theta, cols, &mut ws.r, &mut ws.jac.rows_mut(0, m));
     let w = problem.weights();
     let mut cost = 0.0;
     let mut wrss = 0.0;

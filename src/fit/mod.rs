@@ -25,7 +25,7 @@ pub use identify::{IdentifyOptions, Verdict};
 pub use lm::{LmOptions, Termination};
 pub use loss::{Loss, LossKind};
 pub use metrics::{ChannelMetric, Condition};
-pub use problem::{Param, Problem};
+pub use problem::{Param, Problem, Stack};
 pub use pso::PsoOptions;
 pub use report::FitReport;
 pub use solve::{

@@ -5,7 +5,7 @@
 //! [`Problem`] elsewhere), or approximate a Jacobian by finite differences
 //! behind the caller's back.
 
-use nalgebra::DMatrix;
+use nalgebra::DMatrixViewMut;
 
 /// One model parameter as the fitter sees it.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -83,10 +83,11 @@ pub trait Problem {
     fn residuals(&self, theta: &[f64], r: &mut [f64]);
 
     /// Write r(θ) into `r` and ∂r/∂θ_{cols[k]} into column k of `jac`
-    /// (m × cols.len(), column-major). Only the listed columns are asked
+    /// (m × cols.len(), column-major; a view, so several problems can be
+    /// stacked into one matrix, see [`Stack`]). Only the listed columns are asked
     /// for, so a forward-mode AD implementation seeds only those.
     /// The derivatives must be exact (analytic or AD).
-    fn jacobian(&self, theta: &[f64], cols: &[usize], r: &mut [f64], jac: &mut DMatrix<f64>);
+    fn jacobian(&self, theta: &[f64], cols: &[usize], r: &mut [f64], jac: &mut DMatrixViewMut<f64>);
 
     /// Optional per-residual weights wᵢ ≥ 0 (length m), e.g. 1/σᵢ² of the
     /// channel. `None` means all ones.
@@ -142,4 +143,91 @@ pub fn validate(problem: &dyn Problem, theta: &[f64]) -> crate::Result<()> {
         }
     }
     Ok(())
+}
+
+/// Several problems over the same parameter table fitted together, e.g. Fy
+/// and Mz of a pure-lateral stage: residuals are concatenated and each
+/// part's weights (1 where it has none) multiplied by its factor (typically
+/// 1/σ² of its channel, so newtons and newton-metres compare).
+pub struct Stack<'a> {
+    parts: Vec<(&'a dyn Problem, f64)>,
+    weights: Option<Vec<f64>>,
+    m: usize,
+}
+
+impl<'a> Stack<'a> {
+    /// Stack `parts` (problem, weight factor ≥ 0). All must have the same
+    /// parameter names in the same order; bounds and start come from the first.
+    pub fn new(parts: Vec<(&'a dyn Problem, f64)>) -> crate::Result<Stack<'a>> {
+        let first = parts
+            .first()
+            .ok_or_else(|| crate::Error::Input("fit: nothing to stack".into()))?
+            .0;
+        for (k, (p, f)) in parts.iter().enumerate() {
+            let same = p.params().len() == first.params().len()
+                && p.params()
+                    .iter()
+                    .zip(first.params())
+                    .all(|(a, b)| a.name == b.name);
+            if !same {
+                return Err(crate::Error::Input(format!(
+                    "fit: stacked problem {k} has a different parameter table"
+                )));
+            }
+            if !(f.is_finite() && *f >= 0.0) {
+                return Err(crate::Error::Input(format!(
+                    "fit: stacked problem {k}: weight factor {f} (must be finite and ≥ 0)"
+                )));
+            }
+        }
+        let m = parts.iter().map(|(p, _)| p.n_residuals()).sum();
+        let plain = parts
+            .iter()
+            .all(|(p, f)| *f == 1.0 && p.weights().is_none());
+        let weights = (!plain).then(|| {
+            let mut w = Vec::with_capacity(m);
+            for (p, f) in &parts {
+                match p.weights() {
+                    Some(pw) => w.extend(pw.iter().map(|x| x * f)),
+                    None => w.extend(std::iter::repeat_n(*f, p.n_residuals())),
+                }
+            }
+            w
+        });
+        Ok(Stack { parts, weights, m })
+    }
+}
+
+impl Problem for Stack<'_> {
+    fn params(&self) -> &[Param] {
+        self.parts[0].0.params()
+    }
+    fn n_residuals(&self) -> usize {
+        self.m
+    }
+    fn residuals(&self, theta: &[f64], r: &mut [f64]) {
+        let mut off = 0;
+        for (p, _) in &self.parts {
+            let n = p.n_residuals();
+            p.residuals(theta, &mut r[off..off + n]);
+            off += n;
+        }
+    }
+    fn jacobian(
+        &self,
+        theta: &[f64],
+        cols: &[usize],
+        r: &mut [f64],
+        jac: &mut DMatrixViewMut<f64>,
+    ) {
+        let mut off = 0;
+        for (p, _) in &self.parts {
+            let n = p.n_residuals();
+            p.jacobian(theta, cols, &mut r[off..off + n], &mut jac.rows_mut(off, n));
+            off += n;
+        }
+    }
+    fn weights(&self) -> Option<&[f64]> {
+        self.weights.as_deref()
+    }
 }

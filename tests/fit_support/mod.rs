@@ -2,7 +2,7 @@
 //! analytic gradient, which records every θ it was evaluated at.
 #![allow(dead_code)]
 
-use nalgebra::DMatrix;
+use nalgebra::DMatrixViewMut;
 use std::cell::RefCell;
 use tyrekit::fit::{Param, Problem};
 
@@ -47,7 +47,13 @@ impl Problem for Curve {
             r[i] = (self.model)(theta, self.x[i]) - self.y[i];
         }
     }
-    fn jacobian(&self, theta: &[f64], cols: &[usize], r: &mut [f64], jac: &mut DMatrix<f64>) {
+    fn jacobian(
+        &self,
+        theta: &[f64],
+        cols: &[usize],
+        r: &mut [f64],
+        jac: &mut DMatrixViewMut<f64>,
+    ) {
         self.seen.borrow_mut().push(theta.to_vec());
         let mut g = vec![0.0; theta.len()];
         for i in 0..self.x.len() {

@@ -226,3 +226,29 @@ fn weights_change_the_fit_as_expected() {
     // cost = ½(3·1² + 1·3²) = 6
     assert!((out.cost - 6.0).abs() < 1e-10);
 }
+
+#[test]
+fn steps_into_undefined_region_are_rejected_not_fatal() {
+    // y = ln(a)·x is undefined for a ≤ 0 (NaN). From a = 10 towards the truth
+    // a = 0.05 the full Gauss–Newton step overshoots below zero; such trial
+    // points must be rejected (cost = ∞) and the damping raised.
+    let x = linspace(0.1, 1.0, 10);
+    let y: Vec<f64> = x.iter().map(|&x| 0.05f64.ln() * x).collect();
+    let p = Curve::new(
+        vec![
+            Param::unbounded("a", 10.0),
+            Param::unbounded("b", 0.0).fixed(),
+        ],
+        x,
+        y,
+        |t, x| t[0].ln() * x,
+        |t, x, g| {
+            g[0] = x / t[0];
+            g[1] = 0.0;
+        },
+    );
+    let out = fit(&p, None, None, &FitOptions::default(), "ln", None).unwrap();
+    assert!((out.theta[0] - 0.05).abs() < 1e-9, "{:?}", out.theta);
+    // and it did try an undefined point on the way (otherwise the test proves nothing)
+    assert!(p.seen.borrow().iter().any(|t| t[0] <= 0.0));
+}

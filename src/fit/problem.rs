@@ -82,7 +82,7 @@ pub trait Problem {
     /// Write r(θ) into `r` (length m).
     fn residuals(&self, theta: &[f64], r: &mut [f64]);
 
-    /// Write r(θ) into `r` and ∂r/∂θ_{cols[k]} into column k of `jac`
+    /// Write r(θ) into `r` and ∂r/∂θ for parameter `cols[k]` into column k of `jac`
     /// (m × cols.len(), column-major; a view, so several problems can be
     /// stacked into one matrix, see [`Stack`]). Only the listed columns are asked
     /// for, so a forward-mode AD implementation seeds only those.

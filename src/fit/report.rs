@@ -31,6 +31,11 @@ impl FitReport {
             .map_err(|e| crate::Error::Other(format!("fit.json: cannot serialise the report: {e}")))
     }
 
+    /// Write the JSON to `path` (e.g. `DIR/fit.json`).
+    pub fn write_json(&self, path: &std::path::Path) -> crate::Result<()> {
+        std::fs::write(path, self.to_json()?).map_err(|e| crate::Error::io(path, e))
+    }
+
     /// All tables: parameters per stage, then the quality tables.
     pub fn to_text(&self) -> String {
         let mut s = String::new();

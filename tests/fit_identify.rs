@@ -63,6 +63,17 @@ fn inert_and_collinear_parameters_are_held_and_reported() {
     for n in ["a", "b", "e"] {
         assert_eq!(st(n).status, ParamStatus::Fitted);
     }
+    // The verdicts survive fit.json.
+    let js = serde_json::to_string(&out).unwrap();
+    assert!(js.contains("not_identified"), "{js}");
+    let back: tyrekit::fit::FitOutcome = serde_json::from_str(&js).unwrap();
+    assert_eq!(back.params, out.params);
+    // and the printed table says why
+    let t = tyrekit::fit::report::param_table(&out);
+    assert!(
+        t.contains("not identified (collinear with b)") && t.contains("not identified (no effect)"),
+        "{t}"
+    );
 }
 
 #[test]

@@ -35,3 +35,15 @@ fn lateral_stand_in_recovers_truth_within_standard_errors() {
     );
     assert!((out.residual_variance.sqrt() / sd - 1.0).abs() < 0.05);
 }
+
+#[test]
+fn threaded_row_evaluation_gives_bit_identical_fits() {
+    // par_rows computes every row exactly as the serial loop does and the
+    // fitter's reductions are serial, so the thread count cannot change a bit.
+    let mut p = LateralStandIn::new(LateralData::generate(20_000, 11));
+    let a = fit(&p, None, None, &FitOptions::default(), "1", None).unwrap();
+    p.threads = 3;
+    let b = fit(&p, None, None, &FitOptions::default(), "3", None).unwrap();
+    assert_eq!(a.theta, b.theta);
+    assert_eq!(a.cost.to_bits(), b.cost.to_bits());
+}

@@ -231,3 +231,45 @@ impl Problem for Stack<'_> {
         self.weights.as_deref()
     }
 }
+
+/// Rows per block below which [`par_rows`] does not split further.
+const PAR_MIN_ROWS: usize = 4096;
+
+/// Fill a row-separable problem's residuals (and Jacobian) on up to
+/// `threads` scoped threads: rows are cut into contiguous blocks and
+/// `f(first_row, r_block, jac_block)` fills each block. Every row is computed
+/// exactly as it would be serially, so results do not depend on `threads`.
+/// A helper for [`Problem`] implementations (the fitter itself stays serial).
+pub fn par_rows<F>(
+    threads: usize,
+    first: usize,
+    r: &mut [f64],
+    jac: Option<&mut DMatrixViewMut<f64>>,
+    f: &F,
+) where
+    F: Fn(usize, &mut [f64], Option<&mut DMatrixViewMut<f64>>) + Sync,
+{
+    let m = r.len();
+    if threads <= 1 || m < 2 * PAR_MIN_ROWS {
+        f(first, r, jac);
+        return;
+    }
+    let left_threads = threads / 2;
+    let mid = m * left_threads / threads;
+    let (r1, r2) = r.split_at_mut(mid);
+    match jac {
+        Some(j) => {
+            let (mut j1, mut j2) = j.rows_range_pair_mut(0..mid, mid..m);
+            std::thread::scope(|s| {
+                s.spawn(|| par_rows(left_threads, first, r1, Some(&mut j1), f));
+                par_rows(threads - left_threads, first + mid, r2, Some(&mut j2), f);
+            });
+        }
+        None => {
+            std::thread::scope(|s| {
+                s.spawn(|| par_rows(left_threads, first, r1, None, f));
+                par_rows(threads - left_threads, first + mid, r2, None, f);
+            });
+        }
+    }
+}

@@ -33,7 +33,7 @@
 
 use super::loss::Loss;
 use super::problem::Problem;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DMatrixViewMut, DVector};
 
 /// Stopping criteria and loss of one LM run.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -140,7 +140,9 @@ pub struct Workspace {
     r: Vec<f64>,
     r_trial: Vec<f64>,
     sw: Vec<f64>,
-    jac: DMatrix<f64>,
+    /// Column-major Jacobian storage, m × (largest column count so far);
+    /// a fit with fewer columns uses its leading part (no reallocation).
+    jac: Vec<f64>,
 }
 
 impl Workspace {
@@ -150,14 +152,14 @@ impl Workspace {
             r: vec![0.0; m],
             r_trial: vec![0.0; m],
             sw: vec![0.0; m],
-            jac: DMatrix::zeros(m, n),
+            jac: vec![0.0; m * n],
         }
     }
 
     fn ensure_cols(&mut self, k: usize) {
-        if self.jac.ncols() != k {
-            let m = self.r.len();
-            self.jac = DMatrix::zeros(m, k);
+        let need = self.r.len() * k;
+        if self.jac.len() < need {
+            self.jac.resize(need, 0.0);
         }
     }
 }
@@ -187,11 +189,22 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 /// the k column pieces stay in cache while all k(k+1)/2 products are taken.
 /// Half the products of `jac.tr_mul(&jac)`, and no m-sized temporaries.
 pub fn gram(jac: &DMatrix<f64>, r: &[f64], a: &mut DMatrix<f64>, g: &mut DVector<f64>) {
-    const BLOCK: usize = 2048;
     let (m, k) = jac.shape();
+    gram_slice(jac.as_slice(), m, k, r, a, g);
+}
+
+/// [`gram`] on raw column-major storage (`data.len() ≥ m·k`).
+fn gram_slice(
+    data: &[f64],
+    m: usize,
+    k: usize,
+    r: &[f64],
+    a: &mut DMatrix<f64>,
+    g: &mut DVector<f64>,
+) {
+    const BLOCK: usize = 2048;
     a.fill(0.0);
     g.fill(0.0);
-    let data = jac.as_slice();
     let mut start = 0;
     while start < m {
         let end = (start + BLOCK).min(m);
@@ -231,8 +244,16 @@ pub fn linearise(
 ) -> crate::Result<Linearisation> {
     let m = problem.n_residuals();
     let k = cols.len();
+    if ws.r.len() != m {
+        *ws = Workspace::new(m, k);
+    }
     ws.ensure_cols(k);
-    problem.jacobian(theta, cols, &mut ws.r, &mut ws.jac.rows_mut(0, m));
+    problem.jacobian(
+        theta,
+        cols,
+        &mut ws.r,
+        &mut DMatrixViewMut::from_slice(&mut ws.jac[..m * k], m, k),
+    );
     let w = problem.weights();
     let mut cost = 0.0;
     let mut wrss = 0.0;
@@ -253,9 +274,9 @@ pub fn linearise(
         ws.r_trial.copy_from_slice(&ws.r);
     } else {
         for j in 0..k {
-            let mut col = ws.jac.column_mut(j);
-            for i in 0..m {
-                col[i] *= ws.sw[i];
+            let col = &mut ws.jac[j * m..(j + 1) * m];
+            for (x, s) in col.iter_mut().zip(&ws.sw) {
+                *x *= s;
             }
         }
         for i in 0..m {
@@ -264,7 +285,7 @@ pub fn linearise(
     }
     let mut a = DMatrix::zeros(k, k);
     let mut g = DVector::zeros(k);
-    gram(&ws.jac, &ws.r_trial, &mut a, &mut g);
+    gram_slice(&ws.jac, m, k, &ws.r_trial, &mut a, &mut g);
     // A non-finite Jacobian entry makes its column's diagonal non-finite.
     if (0..k).any(|j| !a[(j, j)].is_finite() || !g[j].is_finite()) {
         return Err(crate::Error::Numeric(

@@ -91,6 +91,15 @@ fn holdout_by_run_and_by_condition() {
     all.extend(s.test_indices());
     all.sort();
     assert_eq!(all, (0..6).collect::<Vec<_>>());
+    // malformed segments (reversed, past the end) neither panic nor mark samples
+    let mut odd = rec();
+    odd.segments.push(seg(5, 3, 3000.0, 0.0));
+    odd.segments.push(seg(4, 99, 3000.0, 0.0));
+    let s2 = Holdout::parse("run:4").unwrap().split(&odd);
+    assert_eq!(s2.test, vec![]);
+    let m = evaluate(&odd, "Fy", &[1.0; 6], None).unwrap();
+    // the 3000 N condition has only samples 4, 5 (from the in-range part of 4..99)
+    assert_eq!(m.last().unwrap().n, 2);
     for bad in ["run:1", "run:x", "sideways"] {
         assert!(Holdout::parse(bad).is_err(), "{bad}");
     }

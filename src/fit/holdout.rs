@@ -105,8 +105,10 @@ impl Holdout {
         // Mark samples, then turn the marks into ranges.
         let mut mark = vec![false; n];
         for (s, &h) in segs.iter().zip(&held) {
-            if h {
-                for m in &mut mark[s.start.min(n)..s.end.min(n)] {
+            // A malformed segment (start ≥ end, or past the samples) marks nothing.
+            let (a, b) = (s.start.min(n), s.end.min(n));
+            if h && a < b {
+                for m in &mut mark[a..b] {
                     *m = true;
                 }
             }

@@ -159,6 +159,12 @@ pub fn fit_global(
     let n_all = params.len();
     let m = problem.n_residuals();
     let loss = opts.lm.loss;
+    if loss.kind != super::loss::LossKind::Linear && !(loss.scale.is_finite() && loss.scale > 0.0) {
+        return Err(crate::Error::Input(format!(
+            "fit stage '{stage}': robust loss scale {} (must be a positive residual size)",
+            loss.scale
+        )));
+    }
     let mut r = vec![0.0; m];
     problem.residuals(&theta0, &mut r);
     let initial_cost = loss.cost(&r, problem.weights());

@@ -21,6 +21,8 @@
 //!
 //! Must never: decide by randomness, or report a standard error for a
 //! parameter that is not identified.
+// `!(x > tol)` on purpose: a NaN must fail the test, not pass it.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use super::lm::Linearisation;
 use super::problem::Param;

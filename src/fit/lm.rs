@@ -30,6 +30,8 @@
 //! Must never: step outside the bounds, use randomness or wall-clock time
 //! (results are bit-reproducible), or panic on a non-finite residual (a
 //! trial step producing one is rejected as if its cost were infinite).
+// Index loops over several parallel per-parameter arrays read clearer than zips.
+#![allow(clippy::needless_range_loop)]
 
 use super::loss::Loss;
 use super::problem::Problem;

@@ -10,6 +10,8 @@
 //! model failure shows as NaN metrics); samples whose *measured* value is
 //! missing (NaN) are skipped, as the recording contract says missing
 //! channels are NaN.
+// Index loops over parallel per-sample arrays read clearer than zips.
+#![allow(clippy::needless_range_loop, clippy::single_range_in_vec_init)]
 
 use crate::data::{Recording, Sample};
 use std::ops::Range;

@@ -4,6 +4,8 @@
 //! Must never: know anything about tyres (the Magic Formula stages implement
 //! [`Problem`] elsewhere), or approximate a Jacobian by finite differences
 //! behind the caller's back.
+// `!(a <= b)` on purpose: NaN bounds must be refused.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use nalgebra::DMatrixViewMut;
 

@@ -1,5 +1,6 @@
 //! Shared test problems for the fit tests: a 1-D curve fit y = f(θ, x) with an
 //! analytic gradient, which records every θ it was evaluated at.
+#![allow(clippy::needless_range_loop)]
 #![allow(dead_code)]
 
 use nalgebra::DMatrixViewMut;

@@ -3,10 +3,45 @@
 //! → score fitted and held-out data per condition → report.
 //! (The model is the benchmark's lateral stand-in until the generic MF lands.)
 
-use tyrekit::bench::fit::{lateral_fy, LateralData, LateralStandIn, FZ0, TRUTH};
+use tyrekit::bench::fit::{lateral_fy, LateralData, FZ0, LOWER, NAMES, START, TRUTH, UPPER};
 use tyrekit::data::{Recording, Sample, Segment, SegmentKind};
 use tyrekit::fit::metrics::evaluate;
-use tyrekit::fit::{fit, FitOptions, FitReport, Holdout};
+use tyrekit::fit::{
+    fit, fit_global, simulate, FitOptions, FitReport, Holdout, Param, PsoOptions, RecordingProblem,
+    SampleModel,
+};
+
+/// The benchmark's lateral stand-in as a per-sample model of Fy.
+struct StandIn(Vec<Param>);
+
+impl StandIn {
+    fn new() -> StandIn {
+        StandIn(
+            (0..18)
+                .map(|i| Param::new(NAMES[i], START[i], LOWER[i], UPPER[i]))
+                .collect(),
+        )
+    }
+}
+
+impl SampleModel for StandIn {
+    fn params(&self) -> &[Param] {
+        &self.0
+    }
+    fn eval(&self, theta: &[f64], s: &Sample, cols: &[usize], grad: Option<&mut [f64]>) -> f64 {
+        match grad {
+            None => lateral_fy(theta, s.alpha, s.fz, s.gamma, None),
+            Some(g) => {
+                let mut full = [0.0; 18];
+                let v = lateral_fy(theta, s.alpha, s.fz, s.gamma, Some(&mut full));
+                for (k, &c) in cols.iter().enumerate() {
+                    g[k] = full[c];
+                }
+                v
+            }
+        }
+    }
+}
 
 fn recording(d: &LateralData) -> Recording {
     let samples: Vec<Sample> = (0..d.fy.len())
@@ -56,18 +91,13 @@ fn fit_on_some_conditions_predicts_the_held_out_ones() {
     assert_eq!(rec.segments.len(), 12); // 4 loads × 3 inclinations
     let split = Holdout::parse("condition:4").unwrap().split(&rec);
     assert_eq!(split.test.len(), 3);
-    let idx = split.train_indices();
-    let train = LateralData {
-        alpha: idx.iter().map(|&i| d.alpha[i]).collect(),
-        fz: idx.iter().map(|&i| d.fz[i]).collect(),
-        gamma: idx.iter().map(|&i| d.gamma[i]).collect(),
-        fy: idx.iter().map(|&i| d.fy[i]).collect(),
-    };
-    let p = LateralStandIn::new(train);
+    let model = StandIn::new();
+    let p = RecordingProblem::new(&model, &rec, "Fy", Some(&split.train))
+        .unwrap()
+        .with_threads(2);
+    assert_eq!(p.sample_indices(), &split.train_indices()[..]);
     let out = fit(&p, None, None, &FitOptions::default(), "pure Fy", None).unwrap();
-    let sim: Vec<f64> = (0..d.fy.len())
-        .map(|i| lateral_fy(&out.theta, d.alpha[i], d.fz[i], d.gamma[i], None))
-        .collect();
+    let sim = simulate(&model, &out.theta, &rec);
     let fitted = evaluate(&rec, "Fy", &sim, Some(&split.train)).unwrap();
     let held = evaluate(&rec, "Fy", &sim, Some(&split.test)).unwrap();
     // per-condition rows only for the conditions present in each half
@@ -99,4 +129,40 @@ fn fit_on_some_conditions_predicts_the_held_out_ones() {
     let text = report.to_text();
     assert!(text.contains("Quality (held-out data)"), "{text}");
     println!("{text}");
+}
+
+#[test]
+fn missing_measurements_are_dropped_and_swarm_runs_on_a_subsample() {
+    let d = LateralData::generate(6_000, 9);
+    let mut rec = recording(&d);
+    for i in (0..rec.samples.len()).step_by(100) {
+        rec.samples[i].fy = f64::NAN;
+    }
+    let model = StandIn::new();
+    let p = RecordingProblem::new(&model, &rec, "fy", None).unwrap();
+    assert_eq!(p.dropped, 60);
+    assert_eq!(p.sample_indices().len(), 6_000 - 60);
+    let sub = p.every(10);
+    assert_eq!(sub.sample_indices().len(), 594);
+    let o = FitOptions {
+        pso: Some(PsoOptions {
+            iterations: 40,
+            ..PsoOptions::default()
+        }),
+        ..FitOptions::default()
+    };
+    let out = fit_global(&p, Some(&sub), None, None, &o, "pure Fy", None).unwrap();
+    // The data are the stand-in plus 1 % noise: every parameter within 4.5
+    // standard errors of the truth (see fit_standin.rs for the reasoning).
+    for (k, r) in out.params.iter().enumerate() {
+        assert!(
+            (r.value - TRUTH[k]).abs() < 4.5 * r.stderr.unwrap(),
+            "{}: {}",
+            r.name,
+            r.value
+        );
+    }
+    assert!(out.cost.is_finite());
+    // an unknown channel is an error, not a panic
+    assert!(RecordingProblem::new(&model, &rec, "torque", None).is_err());
 }

@@ -21,6 +21,9 @@
 //!   For the Magic Formula: seed a dual number per requested column.
 //! - optionally [`Problem::weights`] (e.g. 1/σ² per channel).
 //!
+//! For a model predicting a channel sample by sample, implement
+//! [`SampleModel`] instead and let [`RecordingProblem`] build the problem
+//! (sample selection, NaN dropping, weights, threads, swarm subsample).
 //! Several channels of one stage (Fy and Mz …) go together with [`Stack`].
 //! Then [`fit`] (or [`fit_global`] with a subsampled problem for the swarm)
 //! fits one stage, and [`run_stages`] runs pure Fx → pure Fy → Mz →
@@ -36,6 +39,7 @@ pub mod loss;
 pub mod metrics;
 pub mod problem;
 pub mod pso;
+pub mod recording;
 pub mod report;
 pub mod solve;
 
@@ -46,6 +50,7 @@ pub use loss::{Loss, LossKind};
 pub use metrics::{ChannelMetric, Condition};
 pub use problem::{Param, Problem, Stack};
 pub use pso::PsoOptions;
+pub use recording::{simulate, RecordingProblem, SampleModel};
 pub use report::FitReport;
 pub use solve::{
     fit, fit_global, run_stages, FitOptions, FitOutcome, ParamResult, ParamStatus, ParamValues,

@@ -142,6 +142,18 @@ fn strongly_correlated_but_identifiable_parameters_are_fitted() {
         "{:?}",
         out.theta
     );
+    // For two parameters the estimates' correlation is minus the columns'
+    // cosine: ρ = −Σx·u / √(Σx²·Σu²), u = x + 0.05x² (exact algebra of A⁻¹).
+    let x = linspace(0.0, 1.0, 21);
+    let u: Vec<f64> = x.iter().map(|&x| x + 0.05 * x * x).collect();
+    let sxu: f64 = x.iter().zip(&u).map(|(a, b)| a * b).sum();
+    let sxx: f64 = x.iter().map(|a| a * a).sum();
+    let suu: f64 = u.iter().map(|a| a * a).sum();
+    let rho = -sxu / (sxx * suu).sqrt();
+    assert_eq!(out.correlated.len(), 1);
+    let (a, b, r) = &out.correlated[0];
+    assert_eq!((a.as_str(), b.as_str()), ("a", "b"));
+    assert!((r - rho).abs() < 1e-9, "{r} vs {rho}");
 }
 
 #[test]

@@ -165,3 +165,32 @@ pub fn standard_errors(lin: &Linearisation, keep: &[bool]) -> Vec<Option<f64>> {
     }
     out
 }
+
+/// Pairs of kept columns (indices into `lin.cols`) whose estimates are
+/// correlated beyond `threshold` in absolute value, from the correlation
+/// matrix of A⁻¹ (the posterior correlation of the estimates). Strong
+/// correlation means the data determine mainly a combination of the two:
+/// both are identified, but each alone only loosely.
+pub fn correlated_pairs(
+    lin: &Linearisation,
+    keep: &[bool],
+    threshold: f64,
+) -> Vec<(usize, usize, f64)> {
+    let idx: Vec<usize> = (0..lin.cols.len()).filter(|&k| keep[k]).collect();
+    let n = idx.len();
+    let a = DMatrix::from_fn(n, n, |i, j| lin.a[(idx[i], idx[j])]);
+    let Some(ch) = a.cholesky() else {
+        return Vec::new();
+    };
+    let inv = ch.inverse();
+    let mut out = Vec::new();
+    for i in 0..n {
+        for j in i + 1..n {
+            let rho = inv[(i, j)] / (inv[(i, i)] * inv[(j, j)]).sqrt();
+            if rho.abs() > threshold {
+                out.push((idx[i], idx[j], rho));
+            }
+        }
+    }
+    out
+}

@@ -141,8 +141,16 @@ pub fn param_table(st: &FitOutcome) -> String {
             ]
         })
         .collect();
+    let mut corr = String::new();
+    if !st.correlated.is_empty() {
+        corr.push_str("strongly correlated estimates:");
+        for (a, b, r) in &st.correlated {
+            corr.push_str(&format!(" {a}/{b} ({r:+.3})"));
+        }
+        corr.push('\n');
+    }
     format!(
-        "Stage '{}': cost {} -> {} in {} iterations ({:?}), {} residuals\n{}",
+        "Stage '{}': cost {} -> {} in {} iterations ({:?}), {} residuals\n{}{}",
         st.stage,
         num(st.initial_cost),
         num(st.cost),
@@ -152,7 +160,8 @@ pub fn param_table(st: &FitOutcome) -> String {
         table(
             &["parameter", "start", "value", "std. error", "status"],
             &rows
-        )
+        ),
+        corr
     )
 }
 

@@ -6,7 +6,7 @@
 //! start value and reported as not identified), or talk to a terminal
 //! (progress goes through the optional callback only).
 
-use super::identify::{identify, standard_errors, IdentifyOptions, Verdict};
+use super::identify::{correlated_pairs, identify, standard_errors, IdentifyOptions, Verdict};
 use super::lm::{self, linearise, LmOptions, Termination, Workspace};
 use super::problem::{validate, Problem};
 use super::pso::{self, PsoOptions};
@@ -84,6 +84,9 @@ pub struct FitOutcome {
     pub cost: f64,
     /// Residual variance s² = Σωr²/(m − n_identified).
     pub residual_variance: f64,
+    /// Pairs of fitted parameters whose estimates correlate beyond ±0.95
+    /// (name, name, correlation): the data mainly determine a combination.
+    pub correlated: Vec<(String, String, f64)>,
     pub n_residuals: usize,
     pub iterations: usize,
     pub termination: Termination,
@@ -256,6 +259,7 @@ pub fn fit_global(
 
     // 5. Standard errors over the identified free set.
     let mut stderr = vec![None; n_all];
+    let mut correlated = Vec::new();
     let n_free = (0..n_all).filter(|&i| free[i]).count();
     let mut residual_variance = 2.0 * cost / (m.saturating_sub(n_free).max(1)) as f64;
     if !cols0.is_empty() {
@@ -269,6 +273,10 @@ pub fn fit_global(
         let se = standard_errors(&lin, &keep);
         for (k, &c) in cols0.iter().enumerate() {
             stderr[c] = se[k];
+        }
+        for (i, j, rho) in correlated_pairs(&lin, &keep, 0.95) {
+            let (a, b) = (&params[cols0[i]].name, &params[cols0[j]].name);
+            correlated.push((a.clone(), b.clone(), rho));
         }
     } else {
         problem.residuals(&theta, &mut r);
@@ -304,6 +312,7 @@ pub fn fit_global(
         swarm_cost,
         cost,
         residual_variance,
+        correlated,
         n_residuals: m,
         iterations,
         termination,

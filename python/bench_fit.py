@@ -8,7 +8,8 @@ and bounds.
 Prints one JSON line per method: {"method", "seconds", "cost", "nfev"}.
   trf-jac : method='trf' with the analytic Jacobian (the fair comparison)
   trf-2pt : method='trf' with 2-point finite differences (the usual route)
-Prints "skipped: ..." when NumPy/SciPy are missing.
+Prints "skipped: ..." when NumPy/SciPy are missing. The Rust side runs it with
+one BLAS thread (OPENBLAS_NUM_THREADS=1 …), to compare 1 thread with 1 thread.
 Usage: bench_fit.py DATA.csv
 """
 import json

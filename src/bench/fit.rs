@@ -261,9 +261,15 @@ struct PyResult {
 fn run_python(ctx: &super::BenchContext, csv: &std::path::Path) -> Result<Vec<PyResult>, String> {
     let py = ctx.python.as_ref().ok_or("no Python interpreter given")?;
     let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("python/bench_fit.py");
+    // One BLAS thread, like the tyrekit figure it is divided by: multi-threaded
+    // BLAS on this shared 2-core machine made SciPy 5–10x slower under load,
+    // which would flatter the ratio.
     let out = std::process::Command::new(py)
         .arg(&script)
         .arg(csv)
+        .env("OPENBLAS_NUM_THREADS", "1")
+        .env("OMP_NUM_THREADS", "1")
+        .env("MKL_NUM_THREADS", "1")
         .output()
         .map_err(|e| format!("{}: {e}", py.display()))?;
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -337,7 +343,7 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
         Ok(rs) => {
             for r in rs {
                 println!(
-                    "  SciPy {:<7}       {:>7.3} s  cost {:.9e}  nfev {:>4}  tyrekit (1 thread) {:.1}x faster; cost SciPy/tyrekit − 1 = {:+.1e}",
+                    "  SciPy {:<7} 1 thr {:>7.3} s  cost {:.9e}  nfev {:>4}  tyrekit (1 thread) {:.1}x faster; cost SciPy/tyrekit − 1 = {:+.1e}",
                     r.method,
                     r.seconds,
                     r.cost,

@@ -54,8 +54,8 @@ impl Default for PsoOptions {
 #[derive(Clone, Debug, PartialEq)]
 pub struct PsoResult {
     pub x: Vec<f64>,
-    /// The particles' personal bests, best first, without duplicates
-    /// (`candidates[0] == x`).
+    /// The particles' personal bests with a finite cost, best first, without
+    /// duplicates (`candidates[0] == x` unless no point had a finite cost).
     pub candidates: Vec<Vec<f64>>,
     pub cost: f64,
     pub evaluations: usize,
@@ -166,9 +166,12 @@ pub fn minimize(
     }
     let mut order: Vec<usize> = (0..np).collect();
     order.sort_by(|&a, &b| pcost[a].total_cmp(&pcost[b]).then(a.cmp(&b)));
-    let mut candidates: Vec<Vec<f64>> = vec![gbest.clone()];
+    let mut candidates: Vec<Vec<f64>> = Vec::new();
+    if gcost.is_finite() {
+        candidates.push(gbest.clone());
+    }
     for p in order {
-        if !candidates.iter().any(|c| c == &pbest[p]) {
+        if pcost[p].is_finite() && !candidates.iter().any(|c| c == &pbest[p]) {
             candidates.push(pbest[p].clone());
         }
     }

@@ -229,8 +229,11 @@ pub fn fit_global(
     let mut ws = Workspace::new(m, 0);
     let mut best: Option<Polished> = None;
     let n_starts = starts.len();
+    // A candidate whose polish fails (e.g. the model is undefined there) is
+    // skipped; the fit fails only if every candidate does.
+    let mut first_err = None;
     for (which, cand) in starts.into_iter().enumerate() {
-        let p = polish(
+        let p = match polish(
             problem,
             cand,
             (which, n_starts),
@@ -240,12 +243,22 @@ pub fn fit_global(
             stage,
             progress.as_deref_mut(),
             &mut ws,
-        )?;
+        ) {
+            Ok(p) => p,
+            Err(e) => {
+                first_err.get_or_insert(e);
+                continue;
+            }
+        };
         if best.as_ref().is_none_or(|b| p.cost < b.cost) {
             best = Some(p);
         }
     }
-    let best = best.ok_or_else(|| crate::Error::Numeric("fit: no start to polish".into()))?;
+    let best = match (best, first_err) {
+        (Some(b), _) => b,
+        (None, Some(e)) => return Err(e),
+        (None, None) => return Err(crate::Error::Numeric("fit: no start to polish".into())),
+    };
     let Polished {
         theta,
         free,

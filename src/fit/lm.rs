@@ -7,8 +7,9 @@
 //! iteration and QR-factorises the whole m×n matrix; it also exposes no Gram
 //! matrix for standard errors and the identifiability test. For m = 100 000
 //! residuals and n ≈ 25 parameters the normal equations are the better
-//! trade: JᵀWJ (n×n) is one GEMM over a Jacobian buffer allocated once per
-//! fit, and everything after it is n×n work. The normal equations square
+//! trade: JᵀWJ (n×n) is one cache-blocked symmetric product over a Jacobian
+//! buffer allocated once per fit (the problem writes J straight into it),
+//! and everything after it is n×n work. The normal equations square
 //! the condition number, which is acceptable here because collinear or
 //! inert parameters are removed first (see `identify`) and the damping
 //! keeps the system positive definite.

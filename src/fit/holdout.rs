@@ -1,0 +1,129 @@
+//! holdout — split a recording's segments into the part a fit sees and the
+//! part it is judged on (`--holdout run` or `--holdout condition`).
+//!
+//! Deterministic: every k-th run (segment, in time order) or every k-th
+//! distinct condition (sorted by load, inclination, pressure) is held out,
+//! counting from the k-th, so `run:5` holds out runs 5, 10, 15 … (1-based).
+//! When that would hold out nothing but there are at least two runs
+//! (conditions), the last one is held out instead.
+//!
+//! Must never: put one sample in both halves, or choose at random.
+
+use super::metrics::{conditions, Condition};
+use crate::data::Recording;
+use std::ops::Range;
+
+/// How to hold data out of a fit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum Holdout {
+    None,
+    /// Every `every`-th segment.
+    ByRun {
+        every: usize,
+    },
+    /// Every `every`-th distinct test condition (all its segments).
+    ByCondition {
+        every: usize,
+    },
+}
+
+/// The two halves, as sample ranges in time order.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Split {
+    pub train: Vec<Range<usize>>,
+    pub test: Vec<Range<usize>>,
+}
+
+impl Split {
+    fn indices(r: &[Range<usize>]) -> Vec<usize> {
+        r.iter().flat_map(|r| r.clone()).collect()
+    }
+    /// Sample indices of the training half.
+    pub fn train_indices(&self) -> Vec<usize> {
+        Self::indices(&self.train)
+    }
+    /// Sample indices of the held-out half.
+    pub fn test_indices(&self) -> Vec<usize> {
+        Self::indices(&self.test)
+    }
+}
+
+impl Holdout {
+    /// Parse `none`, `run`, `run:K`, `condition`, `condition:K` (default K = 5).
+    pub fn parse(s: &str) -> crate::Result<Holdout> {
+        let (kind, k) = match s.split_once(':') {
+            Some((a, b)) => (
+                a,
+                b.trim().parse::<usize>().ok().filter(|&k| k >= 2).ok_or_else(|| {
+                    crate::Error::Input(format!(
+                        "--holdout '{s}': after ':' expected a whole number ≥ 2 (hold out every K-th)"
+                    ))
+                })?,
+            ),
+            None => (s, 5),
+        };
+        match kind.trim().to_ascii_lowercase().as_str() {
+            "none" => Ok(Holdout::None),
+            "run" | "runs" => Ok(Holdout::ByRun { every: k }),
+            "condition" | "conditions" => Ok(Holdout::ByCondition { every: k }),
+            _ => Err(crate::Error::Input(format!(
+                "--holdout '{s}': expected none, run, run:K, condition or condition:K"
+            ))),
+        }
+    }
+
+    /// Split the segments of `rec`. Samples outside every segment go to the
+    /// training half (they are fit data only if the caller uses them).
+    pub fn split(&self, rec: &Recording) -> Split {
+        let n = rec.samples.len();
+        let segs = &rec.segments;
+        let held: Vec<bool> = match *self {
+            Holdout::None => vec![false; segs.len()],
+            Holdout::ByRun { every } => {
+                let mut h: Vec<bool> = (0..segs.len()).map(|i| (i + 1) % every == 0).collect();
+                if !h.iter().any(|&x| x) && segs.len() >= 2 {
+                    h[segs.len() - 1] = true;
+                }
+                h
+            }
+            Holdout::ByCondition { every } => {
+                let conds = conditions(rec);
+                let mut out: Vec<bool> = (0..conds.len()).map(|i| (i + 1) % every == 0).collect();
+                if !out.iter().any(|&x| x) && conds.len() >= 2 {
+                    let l = conds.len() - 1;
+                    out[l] = true;
+                }
+                let idx = |s: &crate::data::Segment| {
+                    let c = Condition::of(s);
+                    conds.iter().position(|o| o.same(&c))
+                };
+                segs.iter()
+                    .map(|s| idx(s).is_some_and(|i| out[i]))
+                    .collect()
+            }
+        };
+        // Mark samples, then turn the marks into ranges.
+        let mut mark = vec![false; n];
+        for (s, &h) in segs.iter().zip(&held) {
+            // A malformed segment (start ≥ end, or past the samples) marks nothing.
+            let (a, b) = (s.start.min(n), s.end.min(n));
+            if h && a < b {
+                for m in &mut mark[a..b] {
+                    *m = true;
+                }
+            }
+        }
+        let mut split = Split::default();
+        let mut i = 0;
+        while i < n {
+            let j = (i..n).find(|&j| mark[j] != mark[i]).unwrap_or(n);
+            if mark[i] {
+                split.test.push(i..j);
+            } else {
+                split.train.push(i..j);
+            }
+            i = j;
+        }
+        split
+    }
+}

@@ -1,0 +1,576 @@
+//! lm — bounded Levenberg–Marquardt with Marquardt scaling, trust-region
+//! style damping updates and IRLS robust weights.
+//!
+//! Why not the `levenberg-marquardt` crate (MINPACK port, already a
+//! dependency)? Checked against v0.15: it has no bounds, no per-residual or
+//! IRLS weights, asks the problem for a freshly allocated m×n Jacobian every
+//! iteration and QR-factorises the whole m×n matrix; it also exposes no Gram
+//! matrix for standard errors and the identifiability test. For m = 100 000
+//! residuals and n ≈ 25 parameters the normal equations are the better
+//! trade: JᵀWJ (n×n) is one cache-blocked symmetric product over a Jacobian
+//! buffer allocated once per fit (the problem writes J straight into it),
+//! and everything after it is n×n work. The normal equations square
+//! the condition number, which is acceptable here because collinear or
+//! inert parameters are removed first (see `identify`) and the damping
+//! keeps the system positive definite.
+//!
+//! Algorithm (Marquardt 1963; Moré 1978 for the scaling; Nielsen 1999 for the
+//! damping update; bounds by projection with an active set, as in Kanzow,
+//! Yamashita & Fukushima 2004, "Levenberg–Marquardt methods with strong local
+//! convergence properties for solving nonlinear equations with convex
+//! constraints"):
+//! 1. linearise at θ: r, J; IRLS weights ωᵢ = wᵢ ρ'(zᵢ); A = JᵀΩJ, g = JᵀΩr;
+//! 2. active set: a parameter on a bound whose gradient pushes it outward is
+//!    held this iteration;
+//! 3. solve (A + λ·diag(D)) δ = −g on the rest, D the running maximum of
+//!    diag(A) (Marquardt scaling, MINPACK style);
+//! 4. project θ+δ into the box, accept if the actual cost reduction is a
+//!    positive fraction of the one the quadratic model predicts for the
+//!    projected step; update λ by the gain ratio (Nielsen).
+//!
+//! Must never: step outside the bounds, use randomness or wall-clock time
+//! (results are bit-reproducible), or panic on a non-finite residual (a
+//! trial step producing one is rejected as if its cost were infinite).
+// Index loops over several parallel per-parameter arrays read clearer than zips.
+#![allow(clippy::needless_range_loop)]
+
+use super::loss::Loss;
+use super::problem::Problem;
+use nalgebra::{DMatrix, DMatrixViewMut, DVector};
+
+/// Stopping criteria and loss of one LM run.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct LmOptions {
+    /// Maximum number of Jacobian evaluations (outer iterations).
+    pub max_iter: usize,
+    /// Stop when both actual and predicted relative cost reductions are below this.
+    pub ftol: f64,
+    /// Stop when the scaled step is below this relative to the scaled θ.
+    pub xtol: f64,
+    /// Stop when the largest cosine between the residual and a free Jacobian column is below this.
+    pub gtol: f64,
+    /// Initial damping, relative to the Marquardt scaling (dimensionless).
+    pub lambda0: f64,
+    /// Loss function (plain least squares by default).
+    pub loss: Loss,
+}
+
+impl Default for LmOptions {
+    fn default() -> Self {
+        LmOptions {
+            max_iter: 200,
+            ftol: 1e-12,
+            xtol: 1e-10,
+            gtol: 1e-10,
+            lambda0: 1e-3,
+            loss: Loss::default(),
+        }
+    }
+}
+
+/// Why an LM run stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum Termination {
+    /// Projected gradient below `gtol`.
+    Gradient,
+    /// Step below `xtol`.
+    Step,
+    /// Relative cost reduction below `ftol`.
+    Cost,
+    /// `max_iter` reached.
+    MaxIterations,
+    /// The damping grew without finding a better point (a minimum to machine precision).
+    NoProgress,
+    /// Nothing to fit.
+    NoFreeParameters,
+}
+
+impl Termination {
+    /// Whether the run converged (anything but running out of iterations).
+    pub fn converged(&self) -> bool {
+        !matches!(self, Termination::MaxIterations)
+    }
+}
+
+/// Result of one LM run.
+#[derive(Clone, Debug)]
+pub struct LmResult {
+    /// Solution (all parameters, θ order).
+    pub theta: Vec<f64>,
+    /// Cost ½Σ c²ρ(w r²/c²) at the start.
+    pub initial_cost: f64,
+    /// Cost at the solution.
+    pub cost: f64,
+    /// Outer iterations (Jacobian evaluations).
+    pub iterations: usize,
+    /// Residual evaluations (trial steps).
+    pub residual_evals: usize,
+    pub termination: Termination,
+}
+
+/// The problem linearised at θ over the columns `cols`: the weighted Gram
+/// matrix A = JᵀΩJ, gradient g = JᵀΩr, the cost and Σωr².
+#[derive(Clone, Debug)]
+pub struct Linearisation {
+    pub cols: Vec<usize>,
+    pub a: DMatrix<f64>,
+    pub g: DVector<f64>,
+    pub cost: f64,
+    /// Σ ωᵢ rᵢ² with the IRLS weights ω (= 2·cost for plain least squares).
+    pub wrss: f64,
+    /// Number of residuals m.
+    pub m: usize,
+}
+
+impl Linearisation {
+    /// The same linearisation restricted to a subset of its columns
+    /// (`keep[k]` for column k), e.g. after holding unidentified parameters.
+    pub fn restrict(&self, keep: &[bool]) -> Linearisation {
+        let idx: Vec<usize> = (0..self.cols.len()).filter(|&k| keep[k]).collect();
+        Linearisation {
+            cols: idx.iter().map(|&k| self.cols[k]).collect(),
+            a: DMatrix::from_fn(idx.len(), idx.len(), |i, j| self.a[(idx[i], idx[j])]),
+            g: DVector::from_fn(idx.len(), |i, _| self.g[idx[i]]),
+            cost: self.cost,
+            wrss: self.wrss,
+            m: self.m,
+        }
+    }
+}
+
+/// Reusable buffers (allocated once per fit, never per iteration).
+pub struct Workspace {
+    r: Vec<f64>,
+    r_trial: Vec<f64>,
+    sw: Vec<f64>,
+    /// Column-major Jacobian storage, m × (largest column count so far);
+    /// a fit with fewer columns uses its leading part (no reallocation).
+    jac: Vec<f64>,
+}
+
+impl Workspace {
+    /// Buffers for `m` residuals and up to `n` Jacobian columns.
+    pub fn new(m: usize, n: usize) -> Workspace {
+        Workspace {
+            r: vec![0.0; m],
+            r_trial: vec![0.0; m],
+            sw: vec![0.0; m],
+            jac: vec![0.0; m * n],
+        }
+    }
+
+    fn ensure_cols(&mut self, k: usize) {
+        let need = self.r.len() * k;
+        if self.jac.len() < need {
+            self.jac.resize(need, 0.0);
+        }
+    }
+}
+
+/// Dot product with four independent accumulators (lets the compiler
+/// vectorise; the summation order is fixed, so results are reproducible).
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0f64; 4];
+    let ca = a.chunks_exact(4);
+    let cb = b.chunks_exact(4);
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for l in 0..4 {
+            acc[l] += x[l] * y[l];
+        }
+    }
+    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
+    for (x, y) in ra.iter().zip(rb) {
+        s += x * y;
+    }
+    s
+}
+
+/// Four dot products of `a` with `b[0..4]`, each with two accumulators
+/// (fixed summation order: reproducible).
+#[inline]
+fn dot4(a: &[f64], b: [&[f64]; 4]) -> [f64; 4] {
+    let n = a.len();
+    let mut acc = [[0.0f64; 2]; 4];
+    let half = n / 2 * 2;
+    let mut i = 0;
+    while i < half {
+        let (x0, x1) = (a[i], a[i + 1]);
+        for l in 0..4 {
+            acc[l][0] += x0 * b[l][i];
+            acc[l][1] += x1 * b[l][i + 1];
+        }
+        i += 2;
+    }
+    let mut out = [0.0; 4];
+    for l in 0..4 {
+        out[l] = acc[l][0] + acc[l][1];
+        if half < n {
+            out[l] += a[half] * b[l][half];
+        }
+    }
+    out
+}
+
+/// A = JᵀJ and g = Jᵀr for a column-major m×k `jac`: only the upper
+/// triangle is computed (then mirrored), over row blocks small enough that
+/// the k column pieces stay in cache while all k(k+1)/2 products are taken.
+/// Half the products of `jac.tr_mul(&jac)`, four columns per pass over a
+/// column piece, no m-sized temporaries: ≈ 4.8 ms against 8.5 ms for
+/// `tr_mul` at m = 100 000, k = 18 on the project machine.
+pub fn gram(jac: &DMatrix<f64>, r: &[f64], a: &mut DMatrix<f64>, g: &mut DVector<f64>) {
+    let (m, k) = jac.shape();
+    gram_slice(jac.as_slice(), m, k, r, a, g);
+}
+
+/// [`gram`] on raw column-major storage (`data.len() ≥ m·k`).
+fn gram_slice(
+    data: &[f64],
+    m: usize,
+    k: usize,
+    r: &[f64],
+    a: &mut DMatrix<f64>,
+    g: &mut DVector<f64>,
+) {
+    const BLOCK: usize = 2048;
+    a.fill(0.0);
+    g.fill(0.0);
+    let mut start = 0;
+    while start < m {
+        let end = (start + BLOCK).min(m);
+        let col = |q: usize| &data[q * m + start..q * m + end];
+        for p in 0..k {
+            let cp = col(p);
+            // Four columns against cp at a time: cp is loaded once per four products.
+            let mut q = p;
+            while q + 4 <= k {
+                let d = dot4(cp, [col(q), col(q + 1), col(q + 2), col(q + 3)]);
+                for (l, v) in d.iter().enumerate() {
+                    a[(p, q + l)] += v;
+                }
+                q += 4;
+            }
+            while q < k {
+                a[(p, q)] += dot(cp, col(q));
+                q += 1;
+            }
+            g[p] += dot(cp, &r[start..end]);
+        }
+        start = end;
+    }
+    for p in 0..k {
+        for q in 0..p {
+            a[(p, q)] = a[(q, p)];
+        }
+    }
+}
+
+/// Robust cost of a residual vector (∞ if any residual is not finite).
+fn cost_of(loss: &Loss, r: &[f64], w: Option<&[f64]>) -> f64 {
+    let c = loss.cost(r, w);
+    if c.is_finite() {
+        c
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// Linearise `problem` at `theta` over `cols` (see [`Linearisation`]).
+pub fn linearise(
+    problem: &dyn Problem,
+    theta: &[f64],
+    cols: &[usize],
+    loss: &Loss,
+    ws: &mut Workspace,
+) -> crate::Result<Linearisation> {
+    let m = problem.n_residuals();
+    let k = cols.len();
+    if ws.r.len() != m {
+        *ws = Workspace::new(m, k);
+    }
+    ws.ensure_cols(k);
+    problem.jacobian(
+        theta,
+        cols,
+        &mut ws.r,
+        &mut DMatrixViewMut::from_slice(&mut ws.jac[..m * k], m, k),
+    );
+    let w = problem.weights();
+    let mut cost = 0.0;
+    let mut wrss = 0.0;
+    for i in 0..m {
+        let (c, om) = loss.cost_and_weight(ws.r[i], w.map_or(1.0, |w| w[i]));
+        cost += c;
+        wrss += om * ws.r[i] * ws.r[i];
+        ws.sw[i] = om.sqrt();
+    }
+    if !cost.is_finite() {
+        return Err(crate::Error::Numeric(
+            "fit: the residuals are not finite at the current parameters".into(),
+        ));
+    }
+    // Row scaling by √ω (skipped when every ω is 1: plain, unweighted LS).
+    let unit = w.is_none() && loss.kind == super::loss::LossKind::Linear;
+    if unit {
+        ws.r_trial.copy_from_slice(&ws.r);
+    } else {
+        for j in 0..k {
+            let col = &mut ws.jac[j * m..(j + 1) * m];
+            for (x, s) in col.iter_mut().zip(&ws.sw) {
+                *x *= s;
+            }
+        }
+        for i in 0..m {
+            ws.r_trial[i] = ws.r[i] * ws.sw[i];
+        }
+    }
+    let mut a = DMatrix::zeros(k, k);
+    let mut g = DVector::zeros(k);
+    gram_slice(&ws.jac, m, k, &ws.r_trial, &mut a, &mut g);
+    // A non-finite Jacobian entry makes its column's diagonal non-finite.
+    if (0..k).any(|j| !a[(j, j)].is_finite() || !g[j].is_finite()) {
+        return Err(crate::Error::Numeric(
+            "fit: the Jacobian is not finite at the current parameters".into(),
+        ));
+    }
+    Ok(Linearisation {
+        cols: cols.to_vec(),
+        a,
+        g,
+        cost,
+        wrss,
+        m,
+    })
+}
+
+/// Minimise the problem over the parameters with `free[i]` true, starting at
+/// `theta0` (which must lie within the bounds). `progress(iteration, cost)` is
+/// called after every outer iteration.
+pub fn minimize(
+    problem: &dyn Problem,
+    theta0: &[f64],
+    free: &[bool],
+    opts: &LmOptions,
+    progress: Option<&mut dyn FnMut(usize, f64)>,
+) -> crate::Result<LmResult> {
+    let m = problem.n_residuals();
+    minimize_from(
+        problem,
+        theta0,
+        free,
+        opts,
+        None,
+        &mut Workspace::new(m, 0),
+        progress,
+    )
+}
+
+/// [`minimize`] with a caller-owned workspace and, optionally, the
+/// linearisation at `theta0` over exactly the free columns (saves one
+/// Jacobian evaluation when the caller already has it).
+pub fn minimize_from(
+    problem: &dyn Problem,
+    theta0: &[f64],
+    free: &[bool],
+    opts: &LmOptions,
+    start: Option<Linearisation>,
+    ws: &mut Workspace,
+    mut progress: Option<&mut dyn FnMut(usize, f64)>,
+) -> crate::Result<LmResult> {
+    super::problem::validate(problem, theta0)?;
+    if free.len() != theta0.len() {
+        return Err(crate::Error::Input(format!(
+            "fit: free mask of length {} for {} parameters",
+            free.len(),
+            theta0.len()
+        )));
+    }
+    let params = problem.params();
+    let cols: Vec<usize> = (0..params.len()).filter(|&i| free[i]).collect();
+    let m = problem.n_residuals();
+    let n = cols.len();
+    let mut theta = theta0.to_vec();
+    let w = problem.weights();
+    let loss = &opts.loss;
+    if ws.r.len() != m {
+        *ws = Workspace::new(m, n);
+    }
+    if n == 0 || m == 0 {
+        problem.residuals(&theta, &mut ws.r);
+        let cost = cost_of(loss, &ws.r, w);
+        return Ok(LmResult {
+            theta,
+            initial_cost: cost,
+            cost,
+            iterations: 0,
+            residual_evals: 1,
+            termination: Termination::NoFreeParameters,
+        });
+    }
+    let lower: Vec<f64> = cols.iter().map(|&c| params[c].lower).collect();
+    let upper: Vec<f64> = cols.iter().map(|&c| params[c].upper).collect();
+
+    let mut lin = match start {
+        Some(l) if l.cols == cols && l.m == m => l,
+        _ => linearise(problem, &theta, &cols, loss, ws)?,
+    };
+    let initial_cost = lin.cost;
+    let mut cost = lin.cost;
+    let mut diag = vec![0.0f64; n];
+    let mut lambda = opts.lambda0;
+    let mut nu = 2.0;
+    let mut iterations = 0;
+    let mut residual_evals = 0;
+    let mut trial = theta.clone();
+    let mut mat = DMatrix::<f64>::zeros(n, n);
+    let mut rhs = DVector::<f64>::zeros(n);
+    let mut active = vec![false; n];
+
+    let termination = 'outer: loop {
+        iterations += 1;
+        // Active set: on a bound with the descent direction (−g) pointing out.
+        for k in 0..n {
+            let v = theta[cols[k]];
+            let g = lin.g[k];
+            active[k] = (v <= lower[k] && g > 0.0) || (v >= upper[k] && g < 0.0);
+        }
+        // Gradient test (scaled: cosine between residual and each free column).
+        let mut gmax = 0.0f64;
+        for k in 0..n {
+            if !active[k] && lin.a[(k, k)] > 0.0 && lin.wrss > 0.0 {
+                gmax = gmax.max(lin.g[k].abs() / (lin.a[(k, k)] * lin.wrss).sqrt());
+            }
+        }
+        if gmax <= opts.gtol {
+            break Termination::Gradient;
+        }
+        let amax = (0..n).map(|k| lin.a[(k, k)]).fold(0.0, f64::max);
+        for k in 0..n {
+            diag[k] = diag[k]
+                .max(lin.a[(k, k)])
+                .max(1e-12 * amax)
+                .max(f64::MIN_POSITIVE);
+        }
+        // Inner loop: find an acceptable damped step.
+        loop {
+            mat.copy_from(&lin.a);
+            for k in 0..n {
+                if active[k] {
+                    for j in 0..n {
+                        mat[(k, j)] = 0.0;
+                        mat[(j, k)] = 0.0;
+                    }
+                    mat[(k, k)] = 1.0;
+                    rhs[k] = 0.0;
+                } else {
+                    mat[(k, k)] += lambda * diag[k];
+                    rhs[k] = -lin.g[k];
+                }
+            }
+            let step = match mat.clone().cholesky() {
+                Some(ch) => ch.solve(&rhs),
+                None => {
+                    lambda *= nu;
+                    nu *= 2.0;
+                    if lambda > 1e16 {
+                        break 'outer Termination::NoProgress;
+                    }
+                    continue;
+                }
+            };
+            // Projected step s.
+            trial.copy_from_slice(&theta);
+            let mut s = DVector::<f64>::zeros(n);
+            for k in 0..n {
+                let c = cols[k];
+                let v = (theta[c] + step[k]).max(lower[k]).min(upper[k]);
+                trial[c] = v;
+                s[k] = v - theta[c];
+            }
+            // Predicted reduction of the quadratic model for s.
+            let pred = -(lin.g.dot(&s) + 0.5 * s.dot(&(&lin.a * &s)));
+            let mut dx = 0.0;
+            let mut xn = 0.0;
+            for k in 0..n {
+                dx += diag[k] * s[k] * s[k];
+                xn += diag[k] * theta[cols[k]] * theta[cols[k]];
+            }
+            let (dx, xn) = (dx.sqrt(), xn.sqrt());
+            problem.residuals(&trial, &mut ws.r_trial);
+            residual_evals += 1;
+            let new_cost = cost_of(loss, &ws.r_trial, w);
+            let actual = cost - new_cost;
+            let rho = if pred > 0.0 { actual / pred } else { -1.0 };
+            if rho > 1e-4 {
+                theta.copy_from_slice(&trial);
+                let small_f = actual <= opts.ftol * cost && pred <= opts.ftol * cost;
+                cost = new_cost;
+                lambda *= (1.0f64 / 3.0).max(1.0 - (2.0 * rho - 1.0).powi(3));
+                nu = 2.0;
+                if let Some(p) = progress.as_mut() {
+                    p(iterations, cost);
+                }
+                if small_f {
+                    break 'outer Termination::Cost;
+                }
+                if dx <= opts.xtol * (xn + opts.xtol) {
+                    break 'outer Termination::Step;
+                }
+                if iterations >= opts.max_iter {
+                    break 'outer Termination::MaxIterations;
+                }
+                lin = linearise(problem, &theta, &cols, loss, ws)?;
+                cost = lin.cost;
+                continue 'outer;
+            }
+            // Rejected: a vanishing step means we are at a minimum to precision.
+            if dx <= opts.xtol * (xn + opts.xtol)
+                || (pred <= 0.0 && actual <= 0.0 && pred.abs() <= 1e-15 * cost)
+            {
+                break 'outer Termination::Step;
+            }
+            lambda *= nu;
+            nu *= 2.0;
+            if lambda > 1e16 {
+                break 'outer Termination::NoProgress;
+            }
+        }
+    };
+    if let Some(p) = progress.as_mut() {
+        p(iterations, cost);
+    }
+    Ok(LmResult {
+        theta,
+        initial_cost,
+        cost,
+        iterations,
+        residual_evals,
+        termination,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The blocked symmetric product against nalgebra's plain JᵀJ on an
+    /// awkward shape (rows not a multiple of the block or of 4, 7 columns so
+    /// both the 4-wide and the scalar paths run). Summation orders differ, so
+    /// agreement is to rounding: 1e-12 relative to the largest entry.
+    #[test]
+    fn gram_matches_plain_product() {
+        let (m, k) = (5003, 7);
+        let j = DMatrix::from_fn(m, k, |i, c| ((i * 31 + c * 17) % 97) as f64 / 97.0 - 0.4);
+        let r: Vec<f64> = (0..m).map(|i| ((i * 13) % 29) as f64 - 14.0).collect();
+        let mut a = DMatrix::zeros(k, k);
+        let mut g = DVector::zeros(k);
+        gram(&j, &r, &mut a, &mut g);
+        let a_ref = j.tr_mul(&j);
+        let g_ref = j.tr_mul(&DVector::from_column_slice(&r));
+        let amax = a_ref.amax();
+        assert!((&a - &a_ref).amax() < 1e-12 * amax);
+        assert!((&g - &g_ref).amax() < 1e-12 * g_ref.amax());
+        assert_eq!(a, a.transpose());
+    }
+}

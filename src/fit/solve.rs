@@ -1,0 +1,535 @@
+//! solve — one fit of one [`Problem`]: optional swarm start, identifiability
+//! check, bounded LM polish, standard errors; and a sequence of such fits
+//! (stages) passing the solution on by parameter name.
+//!
+//! Must never: move a parameter the data cannot determine (it is held at its
+//! start value and reported as not identified), or talk to a terminal
+//! (progress goes through the optional callback only).
+
+use super::identify::{correlated_pairs, identify, standard_errors, IdentifyOptions, Verdict};
+use super::lm::{self, linearise, LmOptions, Termination, Workspace};
+use super::problem::{validate, Problem};
+use super::pso::{self, PsoOptions};
+
+/// Settings of one fit.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FitOptions {
+    pub lm: LmOptions,
+    /// Global start by particle swarm (needs finite bounds on the free parameters).
+    pub pso: Option<PsoOptions>,
+    pub identify: IdentifyOptions,
+}
+
+/// What is happening, for a progress display.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    Swarm,
+    Polish,
+}
+
+/// One progress report.
+#[derive(Clone, Copy, Debug)]
+pub struct Progress<'a> {
+    pub stage: &'a str,
+    pub phase: Phase,
+    /// Iteration within the phase, and its upper limit.
+    pub iteration: usize,
+    pub max_iterations: usize,
+    /// Which start is being polished (0-based), of how many (1 without a swarm).
+    pub candidate: usize,
+    pub candidates: usize,
+    /// Best cost so far (within this phase and candidate).
+    pub cost: f64,
+}
+
+/// Progress callback type.
+pub type ProgressFn<'a> = dyn FnMut(&Progress) + 'a;
+
+/// How a parameter came out of the fit.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "status", rename_all = "snake_case")]
+pub enum ParamStatus {
+    /// Not free in this fit.
+    Fixed,
+    /// Fitted, inside its bounds.
+    Fitted,
+    /// Fitted, but ended on a bound (its standard error is only indicative).
+    AtBound,
+    /// Free, but the data cannot determine it: held at its start value.
+    NotIdentified { reason: Verdict },
+}
+
+/// One parameter's result.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ParamResult {
+    pub name: String,
+    pub start: f64,
+    pub value: f64,
+    /// Standard error (identified parameters only).
+    pub stderr: Option<f64>,
+    #[serde(flatten)]
+    pub status: ParamStatus,
+}
+
+/// Result of one fit.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct FitOutcome {
+    pub stage: String,
+    /// All parameter values (θ order of the problem).
+    pub theta: Vec<f64>,
+    pub params: Vec<ParamResult>,
+    pub initial_cost: f64,
+    /// Best swarm cost, if a swarm ran.
+    pub swarm_cost: Option<f64>,
+    pub cost: f64,
+    /// Residual variance s² = Σωr²/(m − n_identified).
+    pub residual_variance: f64,
+    /// Pairs of fitted parameters whose estimates correlate beyond ±0.95
+    /// (name, name, correlation): the data mainly determine a combination.
+    pub correlated: Vec<(String, String, f64)>,
+    pub n_residuals: usize,
+    pub iterations: usize,
+    pub termination: Termination,
+}
+
+impl FitOutcome {
+    /// Value of a parameter by name.
+    pub fn value(&self, name: &str) -> Option<f64> {
+        self.params.iter().find(|p| p.name == name).map(|p| p.value)
+    }
+    /// Result of a parameter by name.
+    pub fn param(&self, name: &str) -> Option<&ParamResult> {
+        self.params.iter().find(|p| p.name == name)
+    }
+}
+
+/// Fit `problem` from `start` (None: the problem's start values) over the
+/// parameters marked in `free` (None: the problem's `free` flags).
+/// The swarm (if `opts.pso` is set) runs on `problem` itself; see
+/// [`fit_global`] to run it on a cheaper subsample.
+pub fn fit(
+    problem: &dyn Problem,
+    start: Option<&[f64]>,
+    free: Option<&[bool]>,
+    opts: &FitOptions,
+    stage: &str,
+    progress: Option<&mut ProgressFn>,
+) -> crate::Result<FitOutcome> {
+    fit_global(problem, None, start, free, opts, stage, progress)
+}
+
+/// [`fit`] with the swarm run on `swarm_problem` (same parameter table, e.g.
+/// every 20th sample: the swarm needs thousands of cost evaluations, the
+/// polish a dozen). `FitOutcome::swarm_cost` is then that problem's cost.
+pub fn fit_global(
+    problem: &dyn Problem,
+    swarm_problem: Option<&dyn Problem>,
+    start: Option<&[f64]>,
+    free: Option<&[bool]>,
+    opts: &FitOptions,
+    stage: &str,
+    mut progress: Option<&mut ProgressFn>,
+) -> crate::Result<FitOutcome> {
+    let params = problem.params();
+    let swarm_problem = swarm_problem.unwrap_or(problem);
+    let same_table = swarm_problem.params().len() == params.len()
+        && swarm_problem
+            .params()
+            .iter()
+            .zip(params)
+            .all(|(a, b)| a.name == b.name);
+    if !same_table {
+        return Err(crate::Error::Input(format!(
+            "fit stage '{stage}': the swarm problem's parameters differ from the problem's"
+        )));
+    }
+    let theta0: Vec<f64> = match start {
+        Some(s) => s.to_vec(),
+        None => params.iter().map(|p| p.start).collect(),
+    };
+    validate(problem, &theta0)?;
+    let free_in: Vec<bool> = match free {
+        Some(f) if f.len() == params.len() => f.to_vec(),
+        Some(f) => {
+            return Err(crate::Error::Input(format!(
+                "fit: free mask of length {} for {} parameters",
+                f.len(),
+                params.len()
+            )))
+        }
+        None => params.iter().map(|p| p.free).collect(),
+    };
+    let n_all = params.len();
+    let m = problem.n_residuals();
+    let loss = opts.lm.loss;
+    if loss.kind != super::loss::LossKind::Linear && !(loss.scale.is_finite() && loss.scale > 0.0) {
+        return Err(crate::Error::Input(format!(
+            "fit stage '{stage}': robust loss scale {} (must be a positive residual size)",
+            loss.scale
+        )));
+    }
+    let mut r = vec![0.0; m];
+    problem.residuals(&theta0, &mut r);
+    let initial_cost = loss.cost(&r, problem.weights());
+
+    // 1. Global start: the swarm's best distinct points, then the given start.
+    let mut starts: Vec<Vec<f64>> = Vec::new();
+    let mut swarm_cost = None;
+    if let Some(po) = &opts.pso {
+        let cols: Vec<usize> = (0..n_all).filter(|&i| free_in[i]).collect();
+        if !cols.is_empty() {
+            let lo: Vec<f64> = cols.iter().map(|&c| params[c].lower).collect();
+            let hi: Vec<f64> = cols.iter().map(|&c| params[c].upper).collect();
+            let x0: Vec<f64> = cols.iter().map(|&c| theta0[c]).collect();
+            let mut th = theta0.clone();
+            let mut rs = vec![0.0; swarm_problem.n_residuals()];
+            let mut cb = |it: usize, c: f64| {
+                if let Some(p) = progress.as_mut() {
+                    p(&Progress {
+                        stage,
+                        phase: Phase::Swarm,
+                        iteration: it,
+                        max_iterations: po.iterations,
+                        candidate: 0,
+                        candidates: 1,
+                        cost: c,
+                    })
+                }
+            };
+            let res = pso::minimize(
+                &lo,
+                &hi,
+                Some(&x0),
+                |x| {
+                    for (k, &c) in cols.iter().enumerate() {
+                        th[c] = x[k];
+                    }
+                    swarm_problem.residuals(&th, &mut rs);
+                    loss.cost(&rs, swarm_problem.weights())
+                },
+                po,
+                Some(&mut cb),
+            )?;
+            for x in res.candidates.iter().take(po.polish.max(1)) {
+                let mut t = theta0.clone();
+                for (k, &c) in cols.iter().enumerate() {
+                    t[c] = x[k];
+                }
+                starts.push(t);
+            }
+            swarm_cost = Some(res.cost);
+        }
+    }
+
+    // 2–4. Polish every candidate start; keep the lowest final cost (ties: the
+    // earlier candidate, so the swarm's best wins over the user's start).
+    if !starts.contains(&theta0) {
+        starts.push(theta0.clone());
+    }
+    let mut ws = Workspace::new(m, 0);
+    let mut best: Option<Polished> = None;
+    let n_starts = starts.len();
+    // A candidate whose polish fails (e.g. the model is undefined there) is
+    // skipped; the fit fails only if every candidate does.
+    let mut first_err = None;
+    for (which, cand) in starts.into_iter().enumerate() {
+        let p = match polish(
+            problem,
+            cand,
+            (which, n_starts),
+            &theta0,
+            &free_in,
+            opts,
+            stage,
+            progress.as_deref_mut(),
+            &mut ws,
+        ) {
+            Ok(p) => p,
+            Err(e) => {
+                first_err.get_or_insert(e);
+                continue;
+            }
+        };
+        if best.as_ref().is_none_or(|b| p.cost < b.cost) {
+            best = Some(p);
+        }
+    }
+    let best = match (best, first_err) {
+        (Some(b), _) => b,
+        (None, Some(e)) => return Err(e),
+        (None, None) => return Err(crate::Error::Numeric("fit: no start to polish".into())),
+    };
+    let Polished {
+        theta,
+        free,
+        verdict,
+        current,
+        iterations,
+        termination,
+        mut cost,
+    } = best;
+    let cols0: Vec<usize> = (0..n_all).filter(|&i| free_in[i]).collect();
+
+    // 5. Standard errors over the identified free set.
+    let mut stderr = vec![None; n_all];
+    let mut correlated = Vec::new();
+    let n_free = (0..n_all).filter(|&i| free[i]).count();
+    let mut residual_variance = 2.0 * cost / (m.saturating_sub(n_free).max(1)) as f64;
+    if !cols0.is_empty() {
+        let lin = match current {
+            Some(l) => l,
+            None => linearise(problem, &theta, &cols0, &loss, &mut ws)?,
+        };
+        cost = lin.cost;
+        residual_variance = lin.wrss / (m.saturating_sub(n_free).max(1)) as f64;
+        let keep: Vec<bool> = cols0.iter().map(|&c| free[c]).collect();
+        let se = standard_errors(&lin, &keep);
+        for (k, &c) in cols0.iter().enumerate() {
+            stderr[c] = se[k];
+        }
+        for (i, j, rho) in correlated_pairs(&lin, &keep, 0.95) {
+            let (a, b) = (&params[cols0[i]].name, &params[cols0[j]].name);
+            correlated.push((a.clone(), b.clone(), rho));
+        }
+    } else {
+        problem.residuals(&theta, &mut r);
+        cost = loss.cost(&r, problem.weights());
+    }
+    let out_params = params
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let status = if let Some(v) = &verdict[i] {
+                ParamStatus::NotIdentified { reason: v.clone() }
+            } else if !free[i] {
+                ParamStatus::Fixed
+            } else if theta[i] <= p.lower || theta[i] >= p.upper {
+                ParamStatus::AtBound
+            } else {
+                ParamStatus::Fitted
+            };
+            ParamResult {
+                name: p.name.clone(),
+                start: theta0[i],
+                value: theta[i],
+                stderr: stderr[i],
+                status,
+            }
+        })
+        .collect();
+    Ok(FitOutcome {
+        stage: stage.to_string(),
+        theta,
+        params: out_params,
+        initial_cost,
+        swarm_cost,
+        cost,
+        residual_variance,
+        correlated,
+        n_residuals: m,
+        iterations,
+        termination,
+    })
+}
+
+/// A polished candidate.
+struct Polished {
+    theta: Vec<f64>,
+    free: Vec<bool>,
+    verdict: Vec<Option<Verdict>>,
+    /// Linearisation over the originally free columns at `theta`, if current.
+    current: Option<super::lm::Linearisation>,
+    iterations: usize,
+    termination: Termination,
+    cost: f64,
+}
+
+/// Identify, polish by LM and re-judge from one start (see `fit_global`).
+#[allow(clippy::too_many_arguments)]
+fn polish(
+    problem: &dyn Problem,
+    theta_init: Vec<f64>,
+    which: (usize, usize),
+    theta0: &[f64],
+    free0: &[bool],
+    opts: &FitOptions,
+    stage: &str,
+    mut progress: Option<&mut ProgressFn>,
+    ws: &mut Workspace,
+) -> crate::Result<Polished> {
+    // 2. Identifiability at the LM start, 3. polish, 4. re-judge every
+    // originally free parameter at the solution: one whose column was zero
+    // only because of where the start was (e.g. a term multiplying a
+    // parameter that started at 0) is released, one that lost its effect is
+    // reset to its start; repeat until the held set is stable (≤ 5 rounds).
+    // While some parameter is held for the first time the LM runs to a loose
+    // tolerance (1e-6): its solution is only where the held set is re-judged,
+    // and converging the reduced model fully would be wasted work. The last
+    // run is always at the caller's tolerances.
+    let params = problem.params();
+    let n_all = params.len();
+    let loss = opts.lm.loss;
+    let mut theta = theta_init;
+    let mut free = free0.to_vec();
+    let mut verdict: Vec<Option<Verdict>> = vec![None; n_all];
+    let mut iterations = 0;
+    let mut termination = Termination::NoFreeParameters;
+    let mut cost = f64::INFINITY;
+    let cols0: Vec<usize> = (0..n_all).filter(|&i| free0[i]).collect();
+    // Linearisation over cols0 valid at the current θ, if any.
+    let mut current: Option<super::lm::Linearisation> = None;
+    let mut last_loose = false;
+    for round in 0..5 {
+        if cols0.is_empty() {
+            break;
+        }
+        let lin = linearise(problem, &theta, &cols0, &loss, ws)?;
+        let v = identify(params, &lin, &opts.identify);
+        let mut held: Vec<Option<Verdict>> = vec![None; n_all];
+        for (k, vk) in v.into_iter().enumerate() {
+            if !vk.is_identified() {
+                held[cols0[k]] = Some(vk);
+            }
+        }
+        let same = (0..n_all).all(|i| held[i].is_some() == verdict[i].is_some());
+        verdict = held;
+        if round > 0 && same && !last_loose {
+            current = Some(lin);
+            break;
+        }
+        let loose = verdict.iter().any(|v| v.is_some()) && !(round > 0 && same) && round < 4;
+        let mut lm_opts = opts.lm.clone();
+        if loose {
+            lm_opts.ftol = lm_opts.ftol.max(1e-6);
+            lm_opts.xtol = lm_opts.xtol.max(1e-6);
+            lm_opts.gtol = lm_opts.gtol.max(1e-6);
+        }
+        last_loose = loose;
+        let mut moved = false;
+        for &c in &cols0 {
+            free[c] = verdict[c].is_none();
+            if verdict[c].is_some() && theta[c] != theta0[c] {
+                theta[c] = theta0[c];
+                moved = true;
+            }
+        }
+        // Reuse the linearisation unless holding a parameter moved θ.
+        let keep: Vec<bool> = cols0.iter().map(|&c| free[c]).collect();
+        let start_lin = (!moved).then(|| lin.restrict(&keep));
+        let max_iter = opts.lm.max_iter;
+        let mut cb = |it: usize, c: f64| {
+            if let Some(p) = progress.as_mut() {
+                p(&Progress {
+                    stage,
+                    phase: Phase::Polish,
+                    iteration: it,
+                    max_iterations: max_iter,
+                    candidate: which.0,
+                    candidates: which.1,
+                    cost: c,
+                })
+            }
+        };
+        let res = lm::minimize_from(
+            problem,
+            &theta,
+            &free,
+            &lm_opts,
+            start_lin,
+            ws,
+            Some(&mut cb),
+        )?;
+        theta = res.theta;
+        iterations += res.iterations;
+        termination = res.termination;
+        cost = res.cost;
+    }
+
+    if cost == f64::INFINITY {
+        let mut r = vec![0.0; problem.n_residuals()];
+        problem.residuals(&theta, &mut r);
+        cost = loss.cost(&r, problem.weights());
+    }
+    Ok(Polished {
+        theta,
+        free,
+        verdict,
+        current,
+        iterations,
+        termination,
+        cost,
+    })
+}
+
+/// One stage of a staged fit.
+pub struct Stage<'a> {
+    pub name: String,
+    /// The stage's problem (its own data subset and residual channels).
+    pub problem: &'a dyn Problem,
+    /// Names of the parameters this stage fits; empty = the problem's `free` flags.
+    pub free: Vec<String>,
+    pub options: FitOptions,
+    /// Problem the swarm runs on (a subsample of `problem`); `None` = `problem`.
+    pub swarm_problem: Option<&'a dyn Problem>,
+}
+
+/// Parameter values carried between stages, by name, in first-seen order.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ParamValues(pub Vec<(String, f64)>);
+
+impl ParamValues {
+    pub fn get(&self, name: &str) -> Option<f64> {
+        self.0.iter().find(|(n, _)| n == name).map(|(_, v)| *v)
+    }
+    pub fn set(&mut self, name: &str, value: f64) {
+        match self.0.iter_mut().find(|(n, _)| n == name) {
+            Some(e) => e.1 = value,
+            None => self.0.push((name.to_string(), value)),
+        }
+    }
+}
+
+/// Run `stages` in order. Each stage starts from `values` where they name its
+/// parameters (else from its problem's start), fits its free set, and writes
+/// its solution back into `values` for the stages after it.
+pub fn run_stages(
+    stages: &[Stage],
+    values: &mut ParamValues,
+    mut progress: Option<&mut ProgressFn>,
+) -> crate::Result<Vec<FitOutcome>> {
+    let mut out = Vec::with_capacity(stages.len());
+    for st in stages {
+        let params = st.problem.params();
+        let start: Vec<f64> = params
+            .iter()
+            .map(|p| values.get(&p.name).map_or(p.start, |v| p.clamp(v)))
+            .collect();
+        let free: Vec<bool> = if st.free.is_empty() {
+            params.iter().map(|p| p.free).collect()
+        } else {
+            for n in &st.free {
+                if !params.iter().any(|p| &p.name == n) {
+                    return Err(crate::Error::Input(format!(
+                        "fit stage '{}': unknown parameter '{n}'",
+                        st.name
+                    )));
+                }
+            }
+            params.iter().map(|p| st.free.contains(&p.name)).collect()
+        };
+        let res = fit_global(
+            st.problem,
+            st.swarm_problem,
+            Some(&start),
+            Some(&free),
+            &st.options,
+            &st.name,
+            progress.as_deref_mut(),
+        )?;
+        for (p, v) in params.iter().zip(&res.theta) {
+            values.set(&p.name, *v);
+        }
+        out.push(res);
+    }
+    Ok(out)
+}

@@ -502,9 +502,11 @@ impl Slip {
 
 /// Checks the inputs a step uses; returns the friction scale in use.
 fn validate(mode: InputMode, inp: &WheelInput, dt: f64) -> crate::Result<f64> {
-    if !(dt.is_finite() && dt > 0.0) {
+    // dt = 0 is allowed: it returns the outputs of the current state without
+    // advancing it (the FMU asks for outputs in initialization mode that way).
+    if !(dt.is_finite() && dt >= 0.0) {
         return Err(crate::Error::Input(format!(
-            "transient step: dt = {dt} s, expected a finite step > 0"
+            "transient step: dt = {dt} s, expected a finite step >= 0"
         )));
     }
     let named = [

@@ -41,7 +41,6 @@ pub fn reference_input(r: &[f64], col: impl Fn(&str) -> usize) -> tyrekit::mf::M
     }
 }
 
-
 use tyrekit::mf::{MfInput, MfOutput, Tyre, UseMode};
 use tyrekit::transient::{
     InputMode, TransientConfig, TransientKind, TransientModel, TransientOptions, WheelInput,

@@ -295,3 +295,19 @@ fn api_cannot_make_the_writer_write_a_key_twice() {
         Some("kept")
     );
 }
+
+/// A value that starts like a number but is not one is a typo: refused with
+/// file, line and key, never silently replaced by the default.
+#[test]
+fn malformed_number_is_an_error_naming_file_line_key() {
+    for bad in ["0.3.1", "1,5", "-", "2e"] {
+        let text = format!("[MODEL]\nFITTYP = 61\n[DIMENSION]\nUNLOADED_RADIUS = {bad}\n{COEFFS}");
+        let e = TyreParams::from_tir_str(&text, "typo.tir")
+            .expect_err(&format!("UNLOADED_RADIUS = {bad} accepted"))
+            .to_string();
+        assert!(
+            e.contains("typo.tir") && e.contains(":4") && e.contains("UNLOADED_RADIUS"),
+            "{bad}: {e}"
+        );
+    }
+}

@@ -109,6 +109,22 @@ pub fn read(text: &str, file: &str) -> Result<ReadOut> {
                     }
                 }
                 ref other => {
+                    // A value that starts like a number but does not parse
+                    // (`0.3.1`, `1,5`, `2e`) is a typo in a number: refusing it
+                    // is safer than running on a silently defaulted radius or
+                    // load. Words (`MASS = kg`, seen in published files) and
+                    // empty values are only warned about.
+                    if let Some(s) = other.as_str() {
+                        let t = s.trim();
+                        if t.starts_with(|c: char| c.is_ascii_digit() || matches!(c, '+' | '-' | '.')) {
+                            return Err(Error::Tir {
+                                file: file.to_string(),
+                                line: e.line,
+                                key: def.name.to_string(),
+                                message: format!("expected a number, found {:?}", truncate(t)),
+                            });
+                        }
+                    }
                     let found = match other.as_str() {
                         Some(s) => format!("found {:?}", truncate(s)),
                         None => "found an empty value".to_string(),

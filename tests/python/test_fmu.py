@@ -398,8 +398,7 @@ def test_bad_tir_content(make, log, unzipdir, tmpdir_path, check_tir, content):
     with open(tir, "w", encoding="latin-1") as f:
         f.write(content)
     verdict = check_tir(tir)
-    if verdict is None:
-        pytest.skip("the library's .tir reader accepts this file (reader of issue #2 not merged yet)")
+    assert verdict is not None, "the library's .tir reader accepts this broken file"
     with pytest.raises(Exception):
         make("badtir", directory=d, init=False)
     assert any("tyre.tir" in m for m in log.errors()), log.text()

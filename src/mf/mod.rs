@@ -203,6 +203,22 @@ impl MfOutput {
     }
 }
 
+/// Zero-slip properties ([`Tyre::slip_properties`]): the same values, names
+/// and units as the [`MfOutput`] fields of an evaluation at κ = α = 0.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[allow(missing_docs)]
+pub struct SlipProps {
+    pub re: f64,
+    pub cx: f64,
+    pub cy: f64,
+    pub kxk: f64,
+    pub kya: f64,
+    pub sigmax: f64,
+    pub sigmay: f64,
+    pub mux: f64,
+    pub muy: f64,
+}
+
 /// A tyre ready to evaluate: the property file plus whatever can be
 /// precomputed from it. Immutable and `Send + Sync`: share it between threads.
 #[derive(Clone, Debug)]
@@ -282,12 +298,26 @@ impl Tyre {
         self.evaluate_checked(inp, mode).0
     }
 
+    /// [`Tyre::evaluate`] on a road of friction `mu_scale` times the one the
+    /// file describes (see [`Model::solve_mu`]: LMUX, LMUY × `mu_scale` in
+    /// every equation, as MF-Tyre treats a road friction change; the slip
+    /// stiffnesses Kxκ, Kyα are unchanged). `mu_scale = 1` is bit-identical
+    /// to [`Tyre::evaluate`]. Allocation-free.
+    pub fn evaluate_mu(&self, inp: &MfInput, mode: UseMode, mu_scale: f64) -> MfOutput {
+        self.evaluate_checked_mu(inp, mode, mu_scale).0
+    }
+
     /// [`Tyre::evaluate`] plus the report of which limits acted.
     pub fn evaluate_checked(&self, inp: &MfInput, mode: UseMode) -> (MfOutput, Clamped) {
+        self.evaluate_checked_mu(inp, mode, 1.0)
+    }
+
+    /// Conditions with ω filled in as [`Tyre::evaluate`] uses it (given, or
+    /// estimated from the Re iteration), and Re, Rω, ω from it.
+    fn conditions_radius(&self, inp: &MfInput, mode: UseMode) -> (Conditions, Clamped, [f64; 3]) {
         let p = &self.params.p;
         let (mut c, cl) = Conditions::new(p, inp, mode);
         let given = if inp.omega.is_nan() { 0.0 } else { inp.omega };
-        // ω: given, or estimated from the Re iteration; then Re, Rω from it.
         let omega_used = if given != 0.0 {
             given
         } else {
@@ -295,7 +325,20 @@ impl Tyre {
         };
         c.omega = omega_used;
         let (re, romega, omega) = extras::effective_radius(p, &c, omega_used);
-        let s = self.model.solve(&c);
+        (c, cl, [re, romega, omega])
+    }
+
+    /// [`Tyre::evaluate_checked`] with a road friction scale (see
+    /// [`Tyre::evaluate_mu`]).
+    pub fn evaluate_checked_mu(
+        &self,
+        inp: &MfInput,
+        mode: UseMode,
+        mu_scale: f64,
+    ) -> (MfOutput, Clamped) {
+        let p = &self.params.p;
+        let (c, cl, [re, romega, omega]) = self.conditions_radius(inp, mode);
+        let s = self.model.solve_mu(&c, mu_scale);
         let is52 = self.model.form != Form::Mf6;
         let is61 = self.params.version == MfVersion::Mf61;
         let (rl, rho, cz) = extras::loaded_radius(p, is61, &c, omega, romega, s.fx, s.fy);
@@ -340,8 +383,15 @@ impl Tyre {
     /// Forces and moments only: the hot path. Allocation-free.
     #[inline]
     pub fn forces(&self, inp: &MfInput, mode: UseMode) -> Forces {
+        self.forces_mu(inp, mode, 1.0)
+    }
+
+    /// [`Tyre::forces`] on a road of friction `mu_scale` times the file's
+    /// (see [`Tyre::evaluate_mu`]); `mu_scale = 1` is bit-identical.
+    #[inline]
+    pub fn forces_mu(&self, inp: &MfInput, mode: UseMode, mu_scale: f64) -> Forces {
         let (c, _) = self.conditions(inp, mode);
-        let s = self.model.solve(&c);
+        let s = self.model.solve_mu(&c, mu_scale);
         Forces {
             fx: s.fx,
             fy: s.fy,
@@ -349,6 +399,38 @@ impl Tyre {
             my: s.my,
             mz: s.mz,
         }
+    }
+
+    /// The zero-slip properties the transient models need each step,
+    /// without the combined-slip and moment equations: the values
+    /// [`Tyre::evaluate_mu`] gives for the same input with κ = α = 0
+    /// (bit-identical; the other inputs as given, ω estimated the same way).
+    pub fn slip_properties_mu(&self, inp: &MfInput, mode: UseMode, mu_scale: f64) -> SlipProps {
+        let zero = MfInput {
+            kappa: 0.0,
+            alpha: 0.0,
+            ..*inp
+        };
+        let (c, _, [re, _, _]) = self.conditions_radius(&zero, mode);
+        let (mux, muy, kxk, kya) = self.model.slip_props(&c, mu_scale);
+        let is52 = self.model.form != Form::Mf6;
+        let (cx, cy, sigmax, sigmay) = extras::relaxation(&self.params.p, is52, &c, kxk, kya);
+        SlipProps {
+            re,
+            cx,
+            cy,
+            kxk,
+            kya,
+            sigmax,
+            sigmay,
+            mux,
+            muy: if mode.limits { muy.abs() } else { muy },
+        }
+    }
+
+    /// [`Tyre::slip_properties_mu`] with `mu_scale = 1`.
+    pub fn slip_properties(&self, inp: &MfInput, mode: UseMode) -> SlipProps {
+        self.slip_properties_mu(inp, mode, 1.0)
     }
 
     /// Batch evaluation over slices (`out.len()` must equal `inp.len()`;

@@ -85,6 +85,7 @@ pub struct Model<T: Real = f64> {
     skip_mx_sin: bool,
     skip_mx_atan: bool,
     pky4_is_2: bool,
+    skip_pky5: bool,
     rcx1_is_1: bool,
     rcy1_is_1: bool,
 }
@@ -95,6 +96,8 @@ struct Fy0<T> {
     fy0: T,
     muy: T,
     kya: T,
+    /// The load shape of Kyα ([`Model::kya_shape`]).
+    shape: T,
     shy: T,
     svy: T,
     by: T,
@@ -138,6 +141,7 @@ impl<T: Real> Model<T> {
         let skip_mx_sin = zero(p.qsx4) || (zero(p.qsx7) && zero(p.qsx8));
         let skip_mx_atan = zero(p.qsx10);
         let pky4_is_2 = !T::TRACKS_DERIVATIVES && p.pky4.v() == 2.0;
+        let skip_pky5 = zero(p.pky5);
         let rcx1_is_1 = !T::TRACKS_DERIVATIVES && p.rcx1.v() == 1.0;
         let rcy1_is_1 = !T::TRACKS_DERIVATIVES && p.rcy1.v() == 1.0;
         Model {
@@ -159,6 +163,7 @@ impl<T: Real> Model<T> {
             skip_mx_sin,
             skip_mx_atan,
             pky4_is_2,
+            skip_pky5,
             rcx1_is_1,
             rcy1_is_1,
         }
@@ -234,17 +239,29 @@ impl<T: Real> Model<T> {
         (fx0, mux, kxk)
     }
 
-    /// Cornering stiffness Kyα (4.E25) at camber `gs`.
+    /// The load shape sin(PKY4·atan(…)) of Kyα (4.E25) at camber `gs`.
     #[inline(always)]
-    fn kya(&self, fz: T, dpi: T, gs: T, zeta3: T) -> T {
+    fn kya_shape(&self, fz: T, dpi: T, gs: T) -> T {
         let p = &self.p;
         let arg = (fz * self.inv_fz0p) / ((p.pky2 + p.pky5 * gs * gs) * (p.ppy2 * dpi + 1.0));
         // sin(2 atan x) = 2x/(1 + x²) for the usual PKY4 = 2 (value-only shortcut).
-        let shape = if self.pky4_is_2 {
+        if self.pky4_is_2 {
             arg * 2.0 / (arg * arg + 1.0)
         } else {
             (p.pky4 * arg.atan()).sin()
-        };
+        }
+    }
+
+    /// Cornering stiffness Kyα (4.E25) at camber `gs`.
+    #[inline(always)]
+    fn kya(&self, fz: T, dpi: T, gs: T, zeta3: T) -> T {
+        self.kya_from_shape(dpi, gs, zeta3, self.kya_shape(fz, dpi, gs))
+    }
+
+    /// Kyα (4.E25) from its load shape ([`Model::kya_shape`]).
+    #[inline(always)]
+    fn kya_from_shape(&self, dpi: T, gs: T, zeta3: T, shape: T) -> T {
+        let p = &self.p;
         p.pky1
             * self.fz0p
             * (p.ppy1 * dpi + 1.0)
@@ -256,6 +273,7 @@ impl<T: Real> Model<T> {
 
     /// Pure lateral force Fy0 (4.E19–4.E30) at camber `gs` (γ*, scaled by LGAY
     /// for PAC2002), with turn slip ζ2, ζ3, ζ4 when `spin` is given.
+    #[allow(clippy::too_many_arguments)]
     fn fy0(
         &self,
         c: &Conditions,
@@ -264,6 +282,7 @@ impl<T: Real> Model<T> {
         gs: T,
         spin: Option<Spin<T>>,
         lmuy: T,
+        shape: Option<T>,
         fl: &mut u32,
     ) -> Fy0<T> {
         let p = &self.p;
@@ -280,7 +299,8 @@ impl<T: Real> Model<T> {
             }
             None => (one, one),
         };
-        let kya = self.kya(fz, dpi, gs, zeta3);
+        let shape = shape.unwrap_or_else(|| self.kya_shape(fz, dpi, gs));
+        let kya = self.kya_from_shape(dpi, gs, zeta3, shape);
         let svyg = fz * (p.pvy3 + p.pvy4 * dfz) * gs * p.lkyc * lmuy * zeta2; // 4.E28
         let kyg0 = if self.is52() {
             // MF-Tyre 5.2: camber stiffness from PHY3 and PVY3/4.
@@ -347,6 +367,7 @@ impl<T: Real> Model<T> {
             fy0,
             muy,
             kya,
+            shape,
             shy,
             svy,
             by,
@@ -521,7 +542,7 @@ impl<T: Real> Model<T> {
             None => T::c(1.0),
         };
         let (fx0, mux, kxk) = self.fx0(c, dfz, dpi, zeta1, gx, p.lmux * mu_scale, fl);
-        let f = self.fy0(c, dfz, dpi, gs_y, spin, p.lmuy * mu_scale, fl);
+        let f = self.fy0(c, dfz, dpi, gs_y, spin, p.lmuy * mu_scale, None, fl);
         Pure {
             dfz,
             dpi,
@@ -686,7 +707,10 @@ impl<T: Real> Model<T> {
             // γ* = 0: the lateral force at γ = 0 is the one just computed.
             f
         } else {
-            self.fy0(c, dfz, dpi, T::c(0.0), spin, lmuy, &mut fl)
+            // With PKY5 = 0 the load shape of Kyα does not depend on γ
+            // (value-only: the same operands give the same bits).
+            let shape = if self.skip_pky5 { Some(f.shape) } else { None };
+            self.fy0(c, dfz, dpi, T::c(0.0), spin, lmuy, shape, &mut fl)
         };
         let svyk0 = svyk_unit * f0.muy;
         let fy_prime = gyk * f0.fy0; // 4.E74

@@ -31,6 +31,19 @@
 //! assert!(dfy_dpdy1 < 0.0);
 //! ```
 //!
+//! Road friction: [`Tyre::evaluate_mu`] / [`Tyre::forces_mu`] (and
+//! [`Model::solve_mu`]) take a road friction scale `mu_scale` that multiplies
+//! LMUX and LMUY wherever they enter the equations — μx, μy, the vertical
+//! shifts, Bt and Br (through 1/λμy) and Dr — the way MF-Tyre treats a road
+//! friction change. The slip stiffnesses Kxκ (4.E15) and Kyα (4.E25) contain
+//! no λμ, so the small-slip response is unchanged while the peaks scale.
+//! `mu_scale = 1` is bit-identical to the plain calls. Nothing allocates.
+//!
+//! Zero-slip properties: [`Tyre::slip_properties`] returns Re, Cx, Cy, Kxκ,
+//! Kyα, σx, σy, μx, μy of an evaluation at κ = α = 0 (bit-identical to
+//! [`Tyre::evaluate`]'s) without the combined-slip and moment equations, for
+//! the transient models' per-step needs.
+//!
 //! Deliberate differences from MFeval 4.0 (the reference test handles each):
 //! the loaded radius of MF 6.2/5.2 files is the exact root of Fz62(Rl) = Fz,
 //! not a Nelder–Mead estimate (Rω at Fz = 0); with turn slip at φt = 0, ζ7 takes
@@ -336,6 +349,19 @@ impl Tyre {
         mode: UseMode,
         mu_scale: f64,
     ) -> (MfOutput, Clamped) {
+        let (out, cl, _) = self.evaluate_full(inp, mode, mu_scale);
+        (out, cl)
+    }
+
+    /// [`Tyre::evaluate_checked_mu`] plus the conditioned α (for the batch's
+    /// finite difference, so that the conditions are computed once per row).
+    #[inline]
+    fn evaluate_full(
+        &self,
+        inp: &MfInput,
+        mode: UseMode,
+        mu_scale: f64,
+    ) -> (MfOutput, Clamped, f64) {
         let p = &self.params.p;
         let (c, cl, [re, romega, omega]) = self.conditions_radius(inp, mode);
         let s = self.model.solve_mu(&c, mu_scale);
@@ -377,7 +403,7 @@ impl Tyre {
             inst_kya: 0.0,
             kxk: s.kxk,
         };
-        (out, Clamped(cl.0 | s.flags))
+        (out, Clamped(cl.0 | s.flags), c.alpha)
     }
 
     /// Forces and moments only: the hot path. Allocation-free.
@@ -439,17 +465,16 @@ impl Tyre {
     /// the last row repeating the previous value; 0 for a single row.
     pub fn evaluate_batch(&self, inp: &[MfInput], mode: UseMode, out: &mut [MfOutput]) {
         let n = inp.len().min(out.len());
-        for (i, o) in inp.iter().zip(out.iter_mut()) {
-            *o = self.evaluate(i, mode);
+        let mut a0 = 0.0;
+        for i in 0..n {
+            let (o, _, a1) = self.evaluate_full(&inp[i], mode, 1.0);
+            out[i] = o;
+            if i > 0 {
+                out[i - 1].inst_kya = (o.fy - out[i - 1].fy) / (a1 - a0);
+            }
+            a0 = a1;
         }
         if n > 1 {
-            let alpha = |i: usize| Conditions::new(&self.params.p, &inp[i], mode).0.alpha;
-            let mut a0 = alpha(0);
-            for i in 0..n - 1 {
-                let a1 = alpha(i + 1);
-                out[i].inst_kya = (out[i + 1].fy - out[i].fy) / (a1 - a0);
-                a0 = a1;
-            }
             out[n - 1].inst_kya = out[n - 2].inst_kya;
         }
     }

@@ -45,6 +45,11 @@ fn symmetric_pac2002() -> TyreParams {
     set(&mut t, "FNOMIN", 4000.0);
     set(&mut t, "PKY1", -18.0);
     set(&mut t, "PKY2", 1.8);
+    // A PAC2002 file has no PKY4 (its Kya has a fixed 2, Adams PAC2002 /
+    // MF-Tyre 5.2): the reader gives the table default 2. The built-in file
+    // is an MF 6.1 set (TVD3 App. 3) with PKY4 = 2.0005, which must not leak
+    // into this PAC2002 fixture.
+    set(&mut t, "PKY4", 2.0);
     set(&mut t, "PDY1", 1.05);
     set(&mut t, "PDY2", -0.08);
     set(&mut t, "PCY1", 1.35);

@@ -243,6 +243,10 @@ pub fn run(ctx: &BenchContext) -> crate::Result<()> {
     let ns_eval = time_ns(&inp, reps, |x| tyre.evaluate(x, mode).re);
     println!("[mf] Tyre::forces   (Fx Fy Mx My Mz, combined slip): {ns_forces:8.1} ns/eval");
     println!("[mf] Tyre::evaluate (all 30 outputs):                {ns_eval:8.1} ns/eval");
+    let ns_mu = time_ns(&inp, reps, |x| sum(tyre.forces_mu(x, mode, 0.6)));
+    let ns_props = time_ns(&inp, reps, |x| tyre.slip_properties(x, mode).kya);
+    println!("[mf] Tyre::forces_mu (road friction scale 0.6):      {ns_mu:8.1} ns/eval");
+    println!("[mf] Tyre::slip_properties (zero-slip Re, C, K, σ, μ): {ns_props:8.1} ns/eval");
     // A fully populated MF 6.1 file (every curvature factor and shift non-zero,
     // so none of the zero-coefficient shortcuts applies), when the shared data
     // is there; the Python peers then run on it.

@@ -85,6 +85,7 @@ pub struct Model<T: Real = f64> {
     skip_mx_sin: bool,
     skip_mx_atan: bool,
     pky4_is_2: bool,
+    skip_pky5: bool,
     rcx1_is_1: bool,
     rcy1_is_1: bool,
 }
@@ -95,11 +96,25 @@ struct Fy0<T> {
     fy0: T,
     muy: T,
     kya: T,
+    /// The load shape of Kyα ([`Model::kya_shape`]).
+    shape: T,
     shy: T,
     svy: T,
     by: T,
     cy: T,
     zeta2: T,
+}
+
+/// The pure-slip results [`Model::solve_mu`] builds on.
+#[derive(Clone, Copy)]
+struct Pure<T> {
+    dfz: T,
+    dpi: T,
+    spin: Option<Spin<T>>,
+    fx0: T,
+    mux: T,
+    kxk: T,
+    f: Fy0<T>,
 }
 
 /// Turn-slip spin φ and camber reduction εγ (Pacejka eqs. 4.76, 4.90).
@@ -126,6 +141,7 @@ impl<T: Real> Model<T> {
         let skip_mx_sin = zero(p.qsx4) || (zero(p.qsx7) && zero(p.qsx8));
         let skip_mx_atan = zero(p.qsx10);
         let pky4_is_2 = !T::TRACKS_DERIVATIVES && p.pky4.v() == 2.0;
+        let skip_pky5 = zero(p.pky5);
         let rcx1_is_1 = !T::TRACKS_DERIVATIVES && p.rcx1.v() == 1.0;
         let rcy1_is_1 = !T::TRACKS_DERIVATIVES && p.rcy1.v() == 1.0;
         Model {
@@ -147,6 +163,7 @@ impl<T: Real> Model<T> {
             skip_mx_sin,
             skip_mx_atan,
             pky4_is_2,
+            skip_pky5,
             rcx1_is_1,
             rcy1_is_1,
         }
@@ -176,14 +193,24 @@ impl<T: Real> Model<T> {
     }
 
     /// Pure longitudinal force Fx0 (4.E9–4.E18), with μx and Kxκ.
-    fn fx0(&self, c: &Conditions, dfz: T, dpi: T, zeta1: T, gx: T, fl: &mut u32) -> (T, T, T) {
+    #[allow(clippy::too_many_arguments)]
+    fn fx0(
+        &self,
+        c: &Conditions,
+        dfz: T,
+        dpi: T,
+        zeta1: T,
+        gx: T,
+        lmux: T,
+        fl: &mut u32,
+    ) -> (T, T, T) {
         let p = &self.p;
         let fz = T::c(c.fz);
         let cx = p.pcx1 * p.lcx; // 4.E11
         let mut mux = (p.pdx1 + p.pdx2 * dfz)
             * (p.ppx3 * dpi + p.ppx4 * dpi * dpi + 1.0)
             * (-(p.pdx3 * gx * gx) + 1.0)
-            * p.lmux; // 4.E13
+            * lmux; // 4.E13
         if c.fz == 0.0 {
             mux = T::c(0.0);
         }
@@ -196,7 +223,7 @@ impl<T: Real> Model<T> {
         let kxk = load * (p.ppx1 * dpi + p.ppx2 * dpi * dpi + 1.0) * p.lkx; // 4.E15
         let bx = kxk / (cx * dx + EPS * sign1(dx)); // 4.E16
         let shx = (p.phx1 + p.phx2 * dfz) * p.lhx * c.smooth; // 4.E17
-        let svx = fz * (p.pvx1 + p.pvx2 * dfz) * p.lvx * p.lmux * zeta1 * c.smooth; // 4.E18
+        let svx = fz * (p.pvx1 + p.pvx2 * dfz) * p.lvx * lmux * zeta1 * c.smooth; // 4.E18
         let kx = shx + c.kappa; // 4.E10
         let ex =
             (p.pex1 + p.pex2 * dfz + p.pex3 * dfz * dfz) * (-(p.pex4 * sign(kx)) + 1.0) * p.lex; // 4.E14
@@ -212,17 +239,29 @@ impl<T: Real> Model<T> {
         (fx0, mux, kxk)
     }
 
-    /// Cornering stiffness Kyα (4.E25) at camber `gs`.
+    /// The load shape sin(PKY4·atan(…)) of Kyα (4.E25) at camber `gs`.
     #[inline(always)]
-    fn kya(&self, fz: T, dpi: T, gs: T, zeta3: T) -> T {
+    fn kya_shape(&self, fz: T, dpi: T, gs: T) -> T {
         let p = &self.p;
         let arg = (fz * self.inv_fz0p) / ((p.pky2 + p.pky5 * gs * gs) * (p.ppy2 * dpi + 1.0));
         // sin(2 atan x) = 2x/(1 + x²) for the usual PKY4 = 2 (value-only shortcut).
-        let shape = if self.pky4_is_2 {
+        if self.pky4_is_2 {
             arg * 2.0 / (arg * arg + 1.0)
         } else {
             (p.pky4 * arg.atan()).sin()
-        };
+        }
+    }
+
+    /// Cornering stiffness Kyα (4.E25) at camber `gs`.
+    #[inline(always)]
+    fn kya(&self, fz: T, dpi: T, gs: T, zeta3: T) -> T {
+        self.kya_from_shape(dpi, gs, zeta3, self.kya_shape(fz, dpi, gs))
+    }
+
+    /// Kyα (4.E25) from its load shape ([`Model::kya_shape`]).
+    #[inline(always)]
+    fn kya_from_shape(&self, dpi: T, gs: T, zeta3: T, shape: T) -> T {
+        let p = &self.p;
         p.pky1
             * self.fz0p
             * (p.ppy1 * dpi + 1.0)
@@ -234,6 +273,7 @@ impl<T: Real> Model<T> {
 
     /// Pure lateral force Fy0 (4.E19–4.E30) at camber `gs` (γ*, scaled by LGAY
     /// for PAC2002), with turn slip ζ2, ζ3, ζ4 when `spin` is given.
+    #[allow(clippy::too_many_arguments)]
     fn fy0(
         &self,
         c: &Conditions,
@@ -241,6 +281,8 @@ impl<T: Real> Model<T> {
         dpi: T,
         gs: T,
         spin: Option<Spin<T>>,
+        lmuy: T,
+        shape: Option<T>,
         fl: &mut u32,
     ) -> Fy0<T> {
         let p = &self.p;
@@ -257,8 +299,9 @@ impl<T: Real> Model<T> {
             }
             None => (one, one),
         };
-        let kya = self.kya(fz, dpi, gs, zeta3);
-        let svyg = fz * (p.pvy3 + p.pvy4 * dfz) * gs * p.lkyc * p.lmuy * zeta2; // 4.E28
+        let shape = shape.unwrap_or_else(|| self.kya_shape(fz, dpi, gs));
+        let kya = self.kya_from_shape(dpi, gs, zeta3, shape);
+        let svyg = fz * (p.pvy3 + p.pvy4 * dfz) * gs * p.lkyc * lmuy * zeta2; // 4.E28
         let kyg0 = if self.is52() {
             // MF-Tyre 5.2: camber stiffness from PHY3 and PVY3/4.
             let kya0 =
@@ -295,14 +338,14 @@ impl<T: Real> Model<T> {
                 + zeta4
                 - 1.0
         };
-        let svy = fz * (p.pvy1 + p.pvy2 * dfz) * p.lvy * p.lmuy * zeta2 + svyg; // 4.E29
+        let svy = fz * (p.pvy1 + p.pvy2 * dfz) * p.lvy * lmuy * zeta2 + svyg; // 4.E29
         let (shy, svy) = (shy * c.smooth, svy * c.smooth);
         let ay = shy + c.alpha_star; // 4.E20
         let cy = p.pcy1 * p.lcy; // 4.E21
         let mut muy = (p.pdy1 + p.pdy2 * dfz)
             * (p.ppy3 * dpi + p.ppy4 * dpi * dpi + 1.0)
             * (-(p.pdy3 * gs * gs) + 1.0)
-            * p.lmuy; // 4.E23
+            * lmuy; // 4.E23
         let dy = muy * fz * zeta2; // 4.E22
         let ey = (p.pey1 + p.pey2 * dfz)
             * (p.pey5 * gs * gs + 1.0 - (p.pey3 + p.pey4 * gs) * sign1(ay))
@@ -324,6 +367,7 @@ impl<T: Real> Model<T> {
             fy0,
             muy,
             kya,
+            shape,
             shy,
             svy,
             by,
@@ -474,34 +518,78 @@ impl<T: Real> Model<T> {
         my
     }
 
-    /// Forces and moments for combined slip (and the by-products).
-    pub fn solve(&self, c: &Conditions) -> Solution<T> {
+    /// The pure-slip part shared by [`Model::solve_mu`] and
+    /// [`Model::slip_props`]: normalised load and pressure (4.E2a, 4.E2b),
+    /// turn-slip spin and ζ1 (4.105, 4.106), Fx0 (4.E9) and Fy0 (4.E19).
+    #[inline(always)]
+    fn pure(&self, c: &Conditions, mu_scale: f64, fl: &mut u32) -> Pure<T> {
         let p = &self.p;
-        let mut fl = 0u32;
-        let one = T::c(1.0);
         let fz = T::c(c.fz);
         let dfz = (fz - self.fz0p) * self.inv_fz0p; // 4.E2a
         let dpi = (T::c(c.p) - p.nompres) * self.inv_nompres; // 4.E2b
-        let gs = T::c(c.gamma_star);
-        let g = T::c(c.gamma);
-        let (gs_y, gx, gs_z, g_z) = (gs * self.lgay, g * self.lgax, gs * self.lgaz, g * self.lgaz);
-        let gs_x = gs * self.lgax;
+        let gs_y = T::c(c.gamma_star) * self.lgay;
+        let gx = T::c(c.gamma) * self.lgax;
         let spin = if c.mode.turn_slip {
             Some(self.spin(c, dfz))
         } else {
             None
         };
-        let r0 = p.unloaded_radius;
-
         let zeta1 = match spin {
             Some(s) => {
                 let bxp = p.pdxp1 * (p.pdxp2 * dfz + 1.0) * cos_atan(p.pdxp3 * c.kappa); // 4.106
-                cos_atan(bxp * r0 * s.phi) // 4.105
+                cos_atan(bxp * p.unloaded_radius * s.phi) // 4.105
             }
-            None => one,
+            None => T::c(1.0),
         };
-        let (fx0, mux, kxk) = self.fx0(c, dfz, dpi, zeta1, gx, &mut fl);
-        let f = self.fy0(c, dfz, dpi, gs_y, spin, &mut fl);
+        let (fx0, mux, kxk) = self.fx0(c, dfz, dpi, zeta1, gx, p.lmux * mu_scale, fl);
+        let f = self.fy0(c, dfz, dpi, gs_y, spin, p.lmuy * mu_scale, None, fl);
+        Pure {
+            dfz,
+            dpi,
+            spin,
+            fx0,
+            mux,
+            kxk,
+            f,
+        }
+    }
+
+    /// The slip-independent by-products of [`Model::solve_mu`] — (μx, μy,
+    /// Kxκ, Kyα) — bit-identical to its `mux`, `muy`, `kxk`, `kya` for the
+    /// same conditions, without the combined-slip and moment equations.
+    pub fn slip_props(&self, c: &Conditions, mu_scale: f64) -> (T, T, T, T) {
+        let mut fl = 0u32;
+        let r = self.pure(c, mu_scale, &mut fl);
+        (r.mux, r.f.muy, r.kxk, r.f.kya)
+    }
+
+    /// Forces and moments for combined slip (and the by-products).
+    #[inline]
+    pub fn solve(&self, c: &Conditions) -> Solution<T> {
+        self.solve_mu(c, 1.0)
+    }
+
+    /// [`Model::solve`] on a road whose friction is `mu_scale` times the one
+    /// the coefficients describe: LMUX and LMUY are multiplied by `mu_scale`
+    /// wherever they appear (μx, μy 4.E13/4.E23; SVx, SVy, SVyγ 4.E18,
+    /// 4.E28/29; Bt A58 and Br 4.E45 through 1/λμy; Dr 4.E47), which is how
+    /// MF-Tyre models a road friction change (Pacejka §4.3.2: λμ* is the
+    /// road-dependent friction scaling). Kxκ and Kyα (4.E15, 4.E25) do not
+    /// contain λμ, so the small-slip stiffness is unchanged. `mu_scale = 1`
+    /// gives bit-identical results to [`Model::solve`] (×1 is exact).
+    pub fn solve_mu(&self, c: &Conditions, mu_scale: f64) -> Solution<T> {
+        let p = &self.p;
+        let lmuy = p.lmuy * mu_scale;
+        let inv_lmuy = self.inv_lmuy * (1.0 / mu_scale);
+        let mut fl = 0u32;
+        let one = T::c(1.0);
+        let r = self.pure(c, mu_scale, &mut fl);
+        let (dfz, dpi, spin, fx0, mux, kxk, f) = (r.dfz, r.dpi, r.spin, r.fx0, r.mux, r.kxk, r.f);
+        let gs = T::c(c.gamma_star);
+        let g = T::c(c.gamma);
+        let (gs_y, gs_z, g_z) = (gs * self.lgay, gs * self.lgaz, g * self.lgaz);
+        let gs_x = gs * self.lgax;
+        let r0 = p.unloaded_radius;
 
         // Aligning-torque ingredients (4.E31–4.E47, Dt and Bt per paper A60, A58).
         let fzm = T::c(c.fz_mz);
@@ -524,7 +612,7 @@ impl<T: Real> Model<T> {
         let bt = (p.qbz1 + p.qbz2 * dfz + p.qbz3 * dfz * dfz)
             * (p.qbz4 * g_z + p.qbz5 * abs(g_z) + 1.0)
             * p.lky
-            * self.inv_lmuy; // A58
+            * inv_lmuy; // A58
         let ct = p.qcz1; // 4.E41
         let qez45 = p.qez4 + p.qez5 * gs_z;
         let et_shape = if !T::TRACKS_DERIVATIVES && qez45.v() == 0.0 {
@@ -592,12 +680,12 @@ impl<T: Real> Model<T> {
                     * gs_z
                     * p.lkzc
                     * zeta0)
-            * p.lmuy
+            * lmuy
             * sign(c.vx)
             * c.alpha_star.cos()
             + zeta8
             - 1.0; // 4.E47
-        let br = (p.qbz9 * p.lky * self.inv_lmuy + p.qbz10 * f.by * f.cy) * zeta6; // 4.E45
+        let br = (p.qbz9 * p.lky * inv_lmuy + p.qbz10 * f.by * f.cy) * zeta6; // 4.E45
         let cr = zeta7; // 4.E46
 
         // Combined-slip aligning torque (4.E71–4.E78 with paper A54–A56).
@@ -619,7 +707,10 @@ impl<T: Real> Model<T> {
             // γ* = 0: the lateral force at γ = 0 is the one just computed.
             f
         } else {
-            self.fy0(c, dfz, dpi, T::c(0.0), spin, &mut fl)
+            // With PKY5 = 0 the load shape of Kyα does not depend on γ
+            // (value-only: the same operands give the same bits).
+            let shape = if self.skip_pky5 { Some(f.shape) } else { None };
+            self.fy0(c, dfz, dpi, T::c(0.0), spin, lmuy, shape, &mut fl)
         };
         let svyk0 = svyk_unit * f0.muy;
         let fy_prime = gyk * f0.fy0; // 4.E74

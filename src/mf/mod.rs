@@ -31,6 +31,19 @@
 //! assert!(dfy_dpdy1 < 0.0);
 //! ```
 //!
+//! Road friction: [`Tyre::evaluate_mu`] / [`Tyre::forces_mu`] (and
+//! [`Model::solve_mu`]) take a road friction scale `mu_scale` that multiplies
+//! LMUX and LMUY wherever they enter the equations — μx, μy, the vertical
+//! shifts, Bt and Br (through 1/λμy) and Dr — the way MF-Tyre treats a road
+//! friction change. The slip stiffnesses Kxκ (4.E15) and Kyα (4.E25) contain
+//! no λμ, so the small-slip response is unchanged while the peaks scale.
+//! `mu_scale = 1` is bit-identical to the plain calls. Nothing allocates.
+//!
+//! Zero-slip properties: [`Tyre::slip_properties`] returns Re, Cx, Cy, Kxκ,
+//! Kyα, σx, σy, μx, μy of an evaluation at κ = α = 0 (bit-identical to
+//! [`Tyre::evaluate`]'s) without the combined-slip and moment equations, for
+//! the transient models' per-step needs.
+//!
 //! Deliberate differences from MFeval 4.0 (the reference test handles each):
 //! the loaded radius of MF 6.2/5.2 files is the exact root of Fz62(Rl) = Fz,
 //! not a Nelder–Mead estimate (Rω at Fz = 0); with turn slip at φt = 0, ζ7 takes
@@ -203,6 +216,22 @@ impl MfOutput {
     }
 }
 
+/// Zero-slip properties ([`Tyre::slip_properties`]): the same values, names
+/// and units as the [`MfOutput`] fields of an evaluation at κ = α = 0.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[allow(missing_docs)]
+pub struct SlipProps {
+    pub re: f64,
+    pub cx: f64,
+    pub cy: f64,
+    pub kxk: f64,
+    pub kya: f64,
+    pub sigmax: f64,
+    pub sigmay: f64,
+    pub mux: f64,
+    pub muy: f64,
+}
+
 /// A tyre ready to evaluate: the property file plus whatever can be
 /// precomputed from it. Immutable and `Send + Sync`: share it between threads.
 #[derive(Clone, Debug)]
@@ -282,12 +311,26 @@ impl Tyre {
         self.evaluate_checked(inp, mode).0
     }
 
+    /// [`Tyre::evaluate`] on a road of friction `mu_scale` times the one the
+    /// file describes (see [`Model::solve_mu`]: LMUX, LMUY × `mu_scale` in
+    /// every equation, as MF-Tyre treats a road friction change; the slip
+    /// stiffnesses Kxκ, Kyα are unchanged). `mu_scale = 1` is bit-identical
+    /// to [`Tyre::evaluate`]. Allocation-free.
+    pub fn evaluate_mu(&self, inp: &MfInput, mode: UseMode, mu_scale: f64) -> MfOutput {
+        self.evaluate_checked_mu(inp, mode, mu_scale).0
+    }
+
     /// [`Tyre::evaluate`] plus the report of which limits acted.
     pub fn evaluate_checked(&self, inp: &MfInput, mode: UseMode) -> (MfOutput, Clamped) {
+        self.evaluate_checked_mu(inp, mode, 1.0)
+    }
+
+    /// Conditions with ω filled in as [`Tyre::evaluate`] uses it (given, or
+    /// estimated from the Re iteration), and Re, Rω, ω from it.
+    fn conditions_radius(&self, inp: &MfInput, mode: UseMode) -> (Conditions, Clamped, [f64; 3]) {
         let p = &self.params.p;
         let (mut c, cl) = Conditions::new(p, inp, mode);
         let given = if inp.omega.is_nan() { 0.0 } else { inp.omega };
-        // ω: given, or estimated from the Re iteration; then Re, Rω from it.
         let omega_used = if given != 0.0 {
             given
         } else {
@@ -295,7 +338,33 @@ impl Tyre {
         };
         c.omega = omega_used;
         let (re, romega, omega) = extras::effective_radius(p, &c, omega_used);
-        let s = self.model.solve(&c);
+        (c, cl, [re, romega, omega])
+    }
+
+    /// [`Tyre::evaluate_checked`] with a road friction scale (see
+    /// [`Tyre::evaluate_mu`]).
+    pub fn evaluate_checked_mu(
+        &self,
+        inp: &MfInput,
+        mode: UseMode,
+        mu_scale: f64,
+    ) -> (MfOutput, Clamped) {
+        let (out, cl, _) = self.evaluate_full(inp, mode, mu_scale);
+        (out, cl)
+    }
+
+    /// [`Tyre::evaluate_checked_mu`] plus the conditioned α (for the batch's
+    /// finite difference, so that the conditions are computed once per row).
+    #[inline]
+    fn evaluate_full(
+        &self,
+        inp: &MfInput,
+        mode: UseMode,
+        mu_scale: f64,
+    ) -> (MfOutput, Clamped, f64) {
+        let p = &self.params.p;
+        let (c, cl, [re, romega, omega]) = self.conditions_radius(inp, mode);
+        let s = self.model.solve_mu(&c, mu_scale);
         let is52 = self.model.form != Form::Mf6;
         let is61 = self.params.version == MfVersion::Mf61;
         let (rl, rho, cz) = extras::loaded_radius(p, is61, &c, omega, romega, s.fx, s.fy);
@@ -334,14 +403,21 @@ impl Tyre {
             inst_kya: 0.0,
             kxk: s.kxk,
         };
-        (out, Clamped(cl.0 | s.flags))
+        (out, Clamped(cl.0 | s.flags), c.alpha)
     }
 
     /// Forces and moments only: the hot path. Allocation-free.
     #[inline]
     pub fn forces(&self, inp: &MfInput, mode: UseMode) -> Forces {
+        self.forces_mu(inp, mode, 1.0)
+    }
+
+    /// [`Tyre::forces`] on a road of friction `mu_scale` times the file's
+    /// (see [`Tyre::evaluate_mu`]); `mu_scale = 1` is bit-identical.
+    #[inline]
+    pub fn forces_mu(&self, inp: &MfInput, mode: UseMode, mu_scale: f64) -> Forces {
         let (c, _) = self.conditions(inp, mode);
-        let s = self.model.solve(&c);
+        let s = self.model.solve_mu(&c, mu_scale);
         Forces {
             fx: s.fx,
             fy: s.fy,
@@ -351,23 +427,54 @@ impl Tyre {
         }
     }
 
+    /// The zero-slip properties the transient models need each step,
+    /// without the combined-slip and moment equations: the values
+    /// [`Tyre::evaluate_mu`] gives for the same input with κ = α = 0
+    /// (bit-identical; the other inputs as given, ω estimated the same way).
+    pub fn slip_properties_mu(&self, inp: &MfInput, mode: UseMode, mu_scale: f64) -> SlipProps {
+        let zero = MfInput {
+            kappa: 0.0,
+            alpha: 0.0,
+            ..*inp
+        };
+        let (c, _, [re, _, _]) = self.conditions_radius(&zero, mode);
+        let (mux, muy, kxk, kya) = self.model.slip_props(&c, mu_scale);
+        let is52 = self.model.form != Form::Mf6;
+        let (cx, cy, sigmax, sigmay) = extras::relaxation(&self.params.p, is52, &c, kxk, kya);
+        SlipProps {
+            re,
+            cx,
+            cy,
+            kxk,
+            kya,
+            sigmax,
+            sigmay,
+            mux,
+            muy: if mode.limits { muy.abs() } else { muy },
+        }
+    }
+
+    /// [`Tyre::slip_properties_mu`] with `mu_scale = 1`.
+    pub fn slip_properties(&self, inp: &MfInput, mode: UseMode) -> SlipProps {
+        self.slip_properties_mu(inp, mode, 1.0)
+    }
+
     /// Batch evaluation over slices (`out.len()` must equal `inp.len()`;
     /// extra elements of either are ignored). `inst_kya` is MFeval's finite
     /// difference ΔFy/Δα between consecutive rows (with the conditioned α),
     /// the last row repeating the previous value; 0 for a single row.
     pub fn evaluate_batch(&self, inp: &[MfInput], mode: UseMode, out: &mut [MfOutput]) {
         let n = inp.len().min(out.len());
-        for (i, o) in inp.iter().zip(out.iter_mut()) {
-            *o = self.evaluate(i, mode);
+        let mut a0 = 0.0;
+        for i in 0..n {
+            let (o, _, a1) = self.evaluate_full(&inp[i], mode, 1.0);
+            out[i] = o;
+            if i > 0 {
+                out[i - 1].inst_kya = (o.fy - out[i - 1].fy) / (a1 - a0);
+            }
+            a0 = a1;
         }
         if n > 1 {
-            let alpha = |i: usize| Conditions::new(&self.params.p, &inp[i], mode).0.alpha;
-            let mut a0 = alpha(0);
-            for i in 0..n - 1 {
-                let a1 = alpha(i + 1);
-                out[i].inst_kya = (out[i + 1].fy - out[i].fy) / (a1 - a0);
-                a0 = a1;
-            }
             out[n - 1].inst_kya = out[n - 2].inst_kya;
         }
     }

@@ -70,6 +70,16 @@ impl Channel {
             Channel::Mz => s.mz,
         }
     }
+    /// The channel of the `f64` hot-path result.
+    pub fn of_forces(self, f: &crate::mf::Forces) -> f64 {
+        match self {
+            Channel::Fx => f.fx,
+            Channel::Fy => f.fy,
+            Channel::Mx => f.mx,
+            Channel::My => f.my,
+            Channel::Mz => f.mz,
+        }
+    }
 }
 
 /// Which fit stage.

@@ -53,6 +53,9 @@ impl Default for MfFitOptions {
     }
 }
 
+/// Sample ranges of one recording: (fitted, held out).
+pub type TrainTest = (Vec<Range<usize>>, Vec<Range<usize>>);
+
 /// Result of [`fit_mf`].
 pub struct MfFit {
     pub tyre: TyreParams,
@@ -60,7 +63,7 @@ pub struct MfFit {
     /// Stages skipped and why.
     pub skipped: Vec<String>,
     /// Per recording: the (train, held-out) sample ranges.
-    pub splits: Vec<(Vec<Range<usize>>, Vec<Range<usize>>)>,
+    pub splits: Vec<TrainTest>,
 }
 
 fn median(mut v: Vec<f64>) -> Option<f64> {
@@ -173,7 +176,7 @@ pub fn fit_mf(
     }
     widen_ranges(&mut tyre, recs)?;
     let form = form_of(tyre.version);
-    let splits: Vec<(Vec<Range<usize>>, Vec<Range<usize>>)> = recs
+    let splits: Vec<TrainTest> = recs
         .iter()
         .map(|r| {
             let s = opts.holdout.split(r);

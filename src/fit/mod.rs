@@ -37,6 +37,8 @@ pub mod identify;
 pub mod lm;
 pub mod loss;
 pub mod metrics;
+pub mod mf_fit;
+pub mod mf_stages;
 pub mod problem;
 pub mod pso;
 pub mod recording;

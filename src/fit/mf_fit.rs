@@ -1,0 +1,314 @@
+//! mf_fit — the staged Magic Formula fit of recordings: nominal values from
+//! the data, pure Fx → pure Fy → Mz → combined ([`super::mf_stages`]), each
+//! stage starting from the values of the stages before it, then the quality
+//! metrics on the fitted and the held-out samples.
+//!
+//! Must never: change a parameter no stage fitted (the start tyre's values
+//! pass through untouched, scaling factors included), print, or panic on
+//! user data.
+
+use super::holdout::Holdout;
+use super::metrics::{self, ChannelMetric};
+use super::mf_stages::{
+    conditions_of, gather, stage_params, Channel, MfStage, StageKind, CAMBER_SPREAD,
+    PRESSURE_SPREAD,
+};
+use super::problem::{Problem, Stack};
+use super::report::FitReport;
+use super::solve::{fit, FitOptions, ProgressFn};
+use crate::data::Recording;
+use crate::mf::{form_of, Model};
+use crate::tir::TyreParams;
+use std::ops::Range;
+
+/// Settings of [`fit_mf`].
+#[derive(Clone, Debug)]
+pub struct MfFitOptions {
+    /// Stages to run (in the fixed order Fx, Fy, Mz, combined).
+    pub only: Vec<StageKind>,
+    pub holdout: Holdout,
+    /// Take FNOMIN, NOMPRES (and INFLPRES), LONGVL from the data.
+    pub nominal_from_data: bool,
+    pub threads: usize,
+    pub fit: FitOptions,
+    /// Minimum samples for a stage to run.
+    pub min_samples: usize,
+}
+
+impl Default for MfFitOptions {
+    fn default() -> Self {
+        MfFitOptions {
+            only: vec![
+                StageKind::PureFx,
+                StageKind::PureFy,
+                StageKind::Mz,
+                StageKind::Combined,
+            ],
+            holdout: Holdout::None,
+            nominal_from_data: true,
+            threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            fit: FitOptions::default(),
+            min_samples: 50,
+        }
+    }
+}
+
+/// Sample ranges of one recording: (fitted, held out).
+pub type TrainTest = (Vec<Range<usize>>, Vec<Range<usize>>);
+
+/// Result of [`fit_mf`].
+pub struct MfFit {
+    pub tyre: TyreParams,
+    pub report: FitReport,
+    /// Stages skipped and why.
+    pub skipped: Vec<String>,
+    /// Per recording: the (train, held-out) sample ranges.
+    pub splits: Vec<TrainTest>,
+}
+
+fn median(mut v: Vec<f64>) -> Option<f64> {
+    v.retain(|x| x.is_finite());
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(|a, b| a.total_cmp(b));
+    Some(v[v.len() / 2])
+}
+
+/// Nominal values from the data: FNOMIN = median of the segments' load set
+/// points, NOMPRES = INFLPRES = median pressure, LONGVL = median speed.
+pub fn nominal_from_data(tyre: &mut TyreParams, recs: &[Recording]) -> crate::Result<()> {
+    let loads: Vec<f64> = recs
+        .iter()
+        .flat_map(|r| r.segments.iter().map(|s| s.fz))
+        .filter(|f| *f > 0.0)
+        .collect();
+    let all = |f: fn(&crate::data::Sample) -> f64| -> Vec<f64> {
+        recs.iter()
+            .flat_map(|r| r.samples.iter().step_by(10).map(f))
+            .collect()
+    };
+    if let Some(f) = median(loads).or_else(|| median(all(|s| s.fz))) {
+        tyre.set("FNOMIN", f)?;
+    }
+    if let Some(p) = median(all(|s| s.p)).filter(|p| *p > 10_000.0) {
+        tyre.set("NOMPRES", p)?;
+        tyre.set("INFLPRES", p)?;
+    }
+    if let Some(v) = median(all(|s| s.vx.abs())).filter(|v| *v > 0.5) {
+        tyre.set("LONGVL", v)?;
+    }
+    Ok(())
+}
+
+/// Widen the range limits of the file (FZMIN/FZMAX, ALPMIN/ALPMAX,
+/// KPUMIN/KPUMAX, CAMMIN/CAMMAX) so they contain the data: a fitted tyre must
+/// not clip the conditions it was fitted on.
+fn widen_ranges(tyre: &mut TyreParams, recs: &[Recording]) -> crate::Result<()> {
+    let span = |f: fn(&crate::data::Sample) -> f64| {
+        let mut lo = f64::INFINITY;
+        let mut hi = f64::NEG_INFINITY;
+        for s in recs.iter().flat_map(|r| &r.samples) {
+            let v = f(s);
+            if v.is_finite() {
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+        }
+        (lo, hi)
+    };
+    for (lo_k, hi_k, f, pad) in [
+        (
+            "FZMIN",
+            "FZMAX",
+            (|s: &crate::data::Sample| s.fz) as fn(&crate::data::Sample) -> f64,
+            1.2,
+        ),
+        ("ALPMIN", "ALPMAX", |s| s.alpha, 1.2),
+        ("KPUMIN", "KPUMAX", |s| s.kappa, 1.2),
+        ("CAMMIN", "CAMMAX", |s| s.gamma, 1.2),
+    ] {
+        let (lo, hi) = span(f);
+        if !(lo.is_finite() && hi.is_finite()) {
+            continue;
+        }
+        if let (Some(a), Some(b)) = (tyre.get(lo_k), tyre.get(hi_k)) {
+            if lo_k != "FZMIN" && lo < a {
+                tyre.set(lo_k, lo * pad)?;
+            }
+            if hi > b {
+                tyre.set(hi_k, hi * pad)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Sample ranges of `kinds` segments intersected with `keep`.
+fn segment_ranges(
+    rec: &Recording,
+    kinds: &[crate::data::SegmentKind],
+    keep: &[Range<usize>],
+) -> Vec<Range<usize>> {
+    let mut out = Vec::new();
+    for seg in rec.segments.iter().filter(|s| kinds.contains(&s.kind)) {
+        for k in keep {
+            let (a, b) = (seg.start.max(k.start), seg.end.min(k.end));
+            if a < b {
+                out.push(a..b);
+            }
+        }
+    }
+    out
+}
+
+/// Fit the Magic Formula to `recs` from `start` (whose version decides the
+/// equation set). See the module doc.
+pub fn fit_mf(
+    recs: &[Recording],
+    start: TyreParams,
+    opts: &MfFitOptions,
+    mut progress: Option<&mut ProgressFn>,
+) -> crate::Result<MfFit> {
+    let mut tyre = start;
+    if opts.nominal_from_data {
+        nominal_from_data(&mut tyre, recs)?;
+    }
+    widen_ranges(&mut tyre, recs)?;
+    let form = form_of(tyre.version);
+    let splits: Vec<TrainTest> = recs
+        .iter()
+        .map(|r| {
+            let s = opts.holdout.split(r);
+            (s.train, s.test)
+        })
+        .collect();
+    let train: Vec<Vec<Range<usize>>> = splits.iter().map(|s| s.0.clone()).collect();
+    let mut report = FitReport {
+        sources: recs.iter().map(|r| r.source.clone()).collect(),
+        ..Default::default()
+    };
+    let mut skipped = Vec::new();
+    let mut fitted_channels: Vec<(Channel, crate::data::SegmentKind)> = Vec::new();
+    for kind in [
+        StageKind::PureFx,
+        StageKind::PureFy,
+        StageKind::Mz,
+        StageKind::Combined,
+    ] {
+        if !opts.only.contains(&kind) {
+            continue;
+        }
+        let (seg, channels) = kind.segments_and_channels();
+        if channels
+            .iter()
+            .any(|c| !recs.iter().any(|r| r.has(c.name())))
+        {
+            skipped.push(format!(
+                "{}: the data have no {:?} channel",
+                kind.name(),
+                channels
+            ));
+            continue;
+        }
+        let data = gather(&tyre.p, recs, Some(&train), seg, channels);
+        if data.conds.len() < opts.min_samples {
+            skipped.push(format!(
+                "{}: {} samples in {} segments (need {})",
+                kind.name(),
+                data.conds.len(),
+                seg.label(),
+                opts.min_samples
+            ));
+            continue;
+        }
+        let params = stage_params(
+            kind,
+            &tyre.p,
+            data.gamma_spread < CAMBER_SPREAD,
+            data.p_spread < PRESSURE_SPREAD,
+        );
+        let parts: Vec<MfStage> = channels
+            .iter()
+            .enumerate()
+            .map(|(k, &c)| {
+                let ms =
+                    data.meas[k].iter().map(|y| y * y).sum::<f64>() / data.meas[k].len() as f64;
+                let w = if channels.len() > 1 && ms > 0.0 {
+                    1.0 / ms
+                } else {
+                    1.0
+                };
+                Ok(MfStage::new(form, &tyre.p, params.clone(), &data, k, c)?
+                    .with_weight(w)
+                    .with_threads(opts.threads))
+            })
+            .collect::<crate::Result<_>>()?;
+        let stack;
+        let problem: &dyn Problem = if parts.len() == 1 {
+            &parts[0]
+        } else {
+            stack = Stack::new(parts.iter().map(|p| (p as &dyn Problem, 1.0)).collect())?;
+            &stack
+        };
+        let out = fit(
+            problem,
+            None,
+            None,
+            &opts.fit,
+            kind.name(),
+            progress.as_deref_mut(),
+        )?;
+        for p in &out.params {
+            tyre.set(&p.name, p.value)?;
+        }
+        report.stages.push(out);
+        for &c in channels {
+            fitted_channels.push((c, seg));
+        }
+    }
+    // Quality: every fitted channel over its segments, fitted and held out.
+    let model = Model::new(tyre.p.clone(), form);
+    for (c, seg) in &fitted_channels {
+        if fitted_channels
+            .iter()
+            .position(|(c2, _)| c2 == c)
+            .is_some_and(|first| fitted_channels[first].1 != *seg)
+        {
+            continue; // scored once, over the segments of its first stage
+        }
+        for (r, rec) in recs.iter().enumerate() {
+            let sim: Vec<f64> = rec
+                .samples
+                .iter()
+                .map(|s| c.of(&model.solve(&conditions_of(&tyre.p, s))))
+                .collect();
+            let kinds = [*seg];
+            let on = segment_ranges(rec, &kinds, &splits[r].0);
+            if !on.is_empty() {
+                report
+                    .metrics
+                    .extend(metrics::evaluate(rec, c.name(), &sim, Some(&on))?);
+            }
+            let off = segment_ranges(rec, &kinds, &splits[r].1);
+            if !off.is_empty() {
+                report
+                    .holdout_metrics
+                    .extend(metrics::evaluate(rec, c.name(), &sim, Some(&off))?);
+            }
+        }
+    }
+    Ok(MfFit {
+        tyre,
+        report,
+        skipped,
+        splits,
+    })
+}
+
+/// The overall (all-conditions) σ of `channel` in `m`, if present.
+pub fn overall_sigma(m: &[ChannelMetric], channel: &str) -> Option<f64> {
+    m.iter()
+        .find(|x| x.channel == channel && x.condition.is_none())
+        .map(|x| x.sigma)
+}

@@ -1,0 +1,463 @@
+//! mf_stages — the Magic Formula as fitting problems: one [`MfStage`] per
+//! channel and group of `.tir` parameters (pure Fy, pure Fx, Mz, combined
+//! slip), with exact Jacobians by forward-mode automatic differentiation
+//! (the free parameters are seeded as `num-dual` dual numbers, eight at a
+//! time, and the crate's own [`crate::mf::Model::solve`] is evaluated over them).
+//!
+//! Stage contents follow the usual industrial order (Pacejka, *Tyre and
+//! Vehicle Dynamics*, 3rd ed., §4.3.2 and Table 4.2): pure slip Fx
+//! (eqs. 4.E9–4.E18), pure slip Fy (4.E19–4.E30), aligning moment
+//! (4.E31–4.E49), then the combined-slip weighting functions (4.E50–4.E67).
+//! Scaling factors (λ) are never fitted.
+//!
+//! Must never: fit a scaling factor, move a camber (pressure) term when the
+//! fitted data hold one inclination (pressure) only — those are held and
+//! reported —, approximate a derivative by finite differences, or allocate
+//! per sample.
+
+use super::problem::{par_rows, Param, Problem};
+use crate::data::{Recording, Sample, SegmentKind};
+use crate::mf::{Conditions, Form, MfInput, Model, Solution, UseMode};
+use crate::tir::keys::key_index;
+use crate::tir::MfParams;
+use nalgebra::{Const, DMatrixViewMut, U1};
+use num_dual::{Derivative, DualSVec64};
+use std::ops::Range;
+
+/// Dual lanes per Jacobian pass (columns seeded at once).
+const LANES: usize = 8;
+type Lanes = DualSVec64<LANES>;
+
+/// A channel the Magic Formula predicts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Channel {
+    Fx,
+    Fy,
+    Mx,
+    My,
+    Mz,
+}
+
+impl Channel {
+    /// Name as in [`crate::data::SAMPLE_CHANNELS`].
+    pub fn name(self) -> &'static str {
+        match self {
+            Channel::Fx => "Fx",
+            Channel::Fy => "Fy",
+            Channel::Mx => "Mx",
+            Channel::My => "My",
+            Channel::Mz => "Mz",
+        }
+    }
+    /// The measured value of a sample.
+    pub fn measured(self, s: &Sample) -> f64 {
+        match self {
+            Channel::Fx => s.fx,
+            Channel::Fy => s.fy,
+            Channel::Mx => s.mx,
+            Channel::My => s.my,
+            Channel::Mz => s.mz,
+        }
+    }
+    /// The channel of a solution.
+    #[inline]
+    pub fn of<T: Copy>(self, s: &Solution<T>) -> T {
+        match self {
+            Channel::Fx => s.fx,
+            Channel::Fy => s.fy,
+            Channel::Mx => s.mx,
+            Channel::My => s.my,
+            Channel::Mz => s.mz,
+        }
+    }
+    /// The channel of the `f64` hot-path result.
+    pub fn of_forces(self, f: &crate::mf::Forces) -> f64 {
+        match self {
+            Channel::Fx => f.fx,
+            Channel::Fy => f.fy,
+            Channel::Mx => f.mx,
+            Channel::My => f.my,
+            Channel::Mz => f.mz,
+        }
+    }
+}
+
+/// Which fit stage.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StageKind {
+    PureFx,
+    PureFy,
+    Mz,
+    Combined,
+}
+
+impl StageKind {
+    /// Parse a `--only` word (`fx`, `fy`, `mz`, `combined`).
+    pub fn parse(s: &str) -> Option<StageKind> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "fx" => Some(StageKind::PureFx),
+            "fy" => Some(StageKind::PureFy),
+            "mz" => Some(StageKind::Mz),
+            "combined" => Some(StageKind::Combined),
+            _ => None,
+        }
+    }
+    /// Stage name in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            StageKind::PureFx => "pure Fx",
+            StageKind::PureFy => "pure Fy",
+            StageKind::Mz => "Mz",
+            StageKind::Combined => "combined",
+        }
+    }
+    /// The segments this stage fits, and the channels.
+    pub fn segments_and_channels(self) -> (SegmentKind, &'static [Channel]) {
+        match self {
+            StageKind::PureFx => (SegmentKind::PureLongitudinal, &[Channel::Fx]),
+            StageKind::PureFy => (SegmentKind::PureLateral, &[Channel::Fy]),
+            StageKind::Mz => (SegmentKind::PureLateral, &[Channel::Mz]),
+            StageKind::Combined => (SegmentKind::Combined, &[Channel::Fx, Channel::Fy]),
+        }
+    }
+    /// The stage's parameters: (key, lower, upper, depends on camber, depends on pressure).
+    pub fn table(self) -> &'static [(&'static str, f64, f64, bool, bool)] {
+        match self {
+            StageKind::PureFy => FY,
+            StageKind::PureFx => FX,
+            StageKind::Mz => MZ,
+            StageKind::Combined => COMBINED,
+        }
+    }
+}
+
+// Bounds: physically meaningful signs where the ISO-W convention fixes them
+// (PKY1 < 0, PKX1 > 0, peaks and shape factors positive, curvature E ≤ 1),
+// otherwise wide boxes that only keep the swarm and LM out of overflow.
+const C: bool = true; // depends on camber
+const P: bool = true; // depends on pressure
+#[rustfmt::skip]
+const FY: &[(&str, f64, f64, bool, bool)] = &[
+    ("pcy1", 0.8, 3.0, false, false), ("pdy1", 0.1, 5.0, false, false),
+    ("pdy2", -2.0, 2.0, false, false), ("pky1", -300.0, -0.1, false, false),
+    ("pky2", 0.05, 20.0, false, false), ("pky4", 1.01, 5.0, false, false),
+    ("pey1", -20.0, 1.0, false, false), ("pey2", -20.0, 20.0, false, false),
+    ("pey3", -10.0, 10.0, false, false), ("phy1", -0.1, 0.1, false, false),
+    ("phy2", -0.1, 0.1, false, false), ("pvy1", -0.5, 0.5, false, false),
+    ("pvy2", -0.5, 0.5, false, false),
+    ("pdy3", -50.0, 50.0, C, false), ("pey4", -50.0, 50.0, C, false),
+    ("pey5", -500.0, 500.0, C, false), ("pky3", -5.0, 5.0, C, false),
+    ("pky5", -500.0, 500.0, C, false), ("pky6", -20.0, 20.0, C, false),
+    ("pky7", -20.0, 20.0, C, false), ("pvy3", -5.0, 5.0, C, false),
+    ("pvy4", -5.0, 5.0, C, false),
+    ("ppy1", -10.0, 10.0, false, P), ("ppy2", -10.0, 10.0, false, P),
+    ("ppy3", -10.0, 10.0, false, P), ("ppy4", -10.0, 10.0, false, P),
+    ("ppy5", -10.0, 10.0, C, P),
+];
+#[rustfmt::skip]
+const FX: &[(&str, f64, f64, bool, bool)] = &[
+    ("pcx1", 0.8, 3.0, false, false), ("pdx1", 0.1, 5.0, false, false),
+    ("pdx2", -2.0, 2.0, false, false), ("pkx1", 0.1, 300.0, false, false),
+    ("pkx2", -50.0, 50.0, false, false), ("pkx3", -5.0, 5.0, false, false),
+    ("pex1", -20.0, 1.0, false, false), ("pex2", -20.0, 20.0, false, false),
+    ("pex3", -20.0, 20.0, false, false), ("pex4", -0.99, 0.99, false, false),
+    ("phx1", -0.05, 0.05, false, false), ("phx2", -0.05, 0.05, false, false),
+    ("pvx1", -0.5, 0.5, false, false), ("pvx2", -0.5, 0.5, false, false),
+    ("pdx3", -50.0, 50.0, C, false),
+    ("ppx1", -10.0, 10.0, false, P), ("ppx2", -10.0, 10.0, false, P),
+    ("ppx3", -10.0, 10.0, false, P), ("ppx4", -10.0, 10.0, false, P),
+];
+#[rustfmt::skip]
+const MZ: &[(&str, f64, f64, bool, bool)] = &[
+    ("qbz1", 0.1, 100.0, false, false), ("qbz2", -50.0, 50.0, false, false),
+    ("qbz3", -50.0, 50.0, false, false), ("qbz9", -100.0, 100.0, false, false),
+    ("qbz10", -10.0, 10.0, false, false), ("qcz1", 0.3, 3.0, false, false),
+    ("qdz1", -1.0, 1.0, false, false), ("qdz2", -1.0, 1.0, false, false),
+    ("qdz6", -1.0, 1.0, false, false), ("qdz7", -1.0, 1.0, false, false),
+    ("qez1", -50.0, 1.0, false, false), ("qez2", -50.0, 50.0, false, false),
+    ("qez3", -50.0, 50.0, false, false), ("qez4", -10.0, 10.0, false, false),
+    ("qhz1", -0.1, 0.1, false, false), ("qhz2", -0.1, 0.1, false, false),
+    ("ssz1", -0.5, 0.5, false, false), ("ssz2", -0.5, 0.5, false, false),
+    ("qbz5", -50.0, 50.0, C, false), ("qbz6", -50.0, 50.0, C, false),
+    ("qdz3", -50.0, 50.0, C, false), ("qdz4", -50.0, 50.0, C, false),
+    ("qdz8", -50.0, 50.0, C, false), ("qdz9", -50.0, 50.0, C, false),
+    ("qdz10", -50.0, 50.0, C, false), ("qdz11", -50.0, 50.0, C, false),
+    ("qez5", -50.0, 50.0, C, false), ("qhz3", -5.0, 5.0, C, false),
+    ("qhz4", -5.0, 5.0, C, false), ("ssz3", -5.0, 5.0, C, false),
+    ("ssz4", -5.0, 5.0, C, false),
+    ("ppz1", -10.0, 10.0, false, P), ("ppz2", -10.0, 10.0, C, P),
+];
+#[rustfmt::skip]
+const COMBINED: &[(&str, f64, f64, bool, bool)] = &[
+    ("rbx1", 0.0, 200.0, false, false), ("rbx2", -200.0, 200.0, false, false),
+    ("rcx1", 0.3, 3.0, false, false), ("rex1", -20.0, 1.0, false, false),
+    ("rex2", -20.0, 20.0, false, false), ("rhx1", -0.1, 0.1, false, false),
+    ("rby1", 0.0, 200.0, false, false), ("rby2", -200.0, 200.0, false, false),
+    ("rby3", -1.0, 1.0, false, false), ("rcy1", 0.3, 3.0, false, false),
+    ("rey1", -20.0, 1.0, false, false), ("rey2", -20.0, 20.0, false, false),
+    ("rhy1", -0.1, 0.1, false, false), ("rhy2", -0.1, 0.1, false, false),
+    ("rvy1", -1.0, 1.0, false, false), ("rvy2", -1.0, 1.0, false, false),
+    ("rvy4", -200.0, 200.0, false, false), ("rvy5", 0.0, 10.0, false, false),
+    ("rvy6", -200.0, 200.0, false, false),
+    ("rbx3", -500.0, 500.0, C, false), ("rby4", -500.0, 500.0, C, false),
+    ("rvy3", -50.0, 50.0, C, false),
+];
+
+/// Spread of the fitted data below which camber (pressure) terms are held:
+/// 0.5° (5 kPa), well below any test plan's steps.
+pub const CAMBER_SPREAD: f64 = 0.5 * std::f64::consts::PI / 180.0;
+pub const PRESSURE_SPREAD: f64 = 5000.0;
+
+/// Conditioned inputs and measured values of the samples one stage fits.
+#[derive(Clone, Debug, Default)]
+pub struct StageData {
+    pub conds: Vec<Conditions>,
+    /// Measured channel per sample, one vector per channel of the stage.
+    pub meas: Vec<Vec<f64>>,
+    /// Spread (max − min) of inclination and pressure over the samples.
+    pub gamma_spread: f64,
+    pub p_spread: f64,
+}
+
+/// The use mode of fitting: no range limits (the start tyre's ranges must
+/// not clip the data), no α*, no turn slip.
+pub const FIT_MODE: UseMode = UseMode {
+    limits: false,
+    alpha_star: false,
+    turn_slip: false,
+};
+
+/// The conditioned inputs of a sample (pressure NaN → the file's INFLPRES).
+pub fn conditions_of(p: &MfParams<f64>, s: &Sample) -> Conditions {
+    let inp = MfInput {
+        fz: s.fz,
+        kappa: s.kappa,
+        alpha: s.alpha,
+        gamma: s.gamma,
+        phit: 0.0,
+        vx: s.vx,
+        p: s.p,
+        omega: 0.0,
+    };
+    Conditions::new(p, &inp, FIT_MODE).0
+}
+
+/// Gather the samples of `kind` segments inside `train` (None: everything)
+/// of every recording where all `channels` are finite and Fz > 0.
+pub fn gather(
+    p: &MfParams<f64>,
+    recs: &[Recording],
+    train: Option<&[Vec<Range<usize>>]>,
+    kind: SegmentKind,
+    channels: &[Channel],
+) -> StageData {
+    let mut d = StageData {
+        meas: vec![Vec::new(); channels.len()],
+        ..Default::default()
+    };
+    let (mut gmin, mut gmax, mut pmin, mut pmax) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for (r, rec) in recs.iter().enumerate() {
+        let keep = |i: usize| train.is_none_or(|t| t[r].iter().any(|rg| rg.contains(&i)));
+        for seg in rec.segments.iter().filter(|s| s.kind == kind) {
+            for i in seg.start..seg.end.min(rec.samples.len()) {
+                let s = &rec.samples[i];
+                let ok = keep(i)
+                    && s.fz > 0.0
+                    && s.fz.is_finite()
+                    && [s.vx, s.kappa, s.alpha, s.gamma]
+                        .iter()
+                        .all(|v| v.is_finite())
+                    && channels.iter().all(|c| c.measured(s).is_finite());
+                if !ok {
+                    continue;
+                }
+                d.conds.push(conditions_of(p, s));
+                for (k, c) in channels.iter().enumerate() {
+                    d.meas[k].push(c.measured(s));
+                }
+                gmin = gmin.min(s.gamma);
+                gmax = gmax.max(s.gamma);
+                if s.p.is_finite() && s.p > 0.0 {
+                    pmin = pmin.min(s.p);
+                    pmax = pmax.max(s.p);
+                }
+            }
+        }
+    }
+    d.gamma_spread = (gmax - gmin).max(0.0);
+    d.p_spread = (pmax - pmin).max(0.0);
+    d
+}
+
+/// One channel of a Magic Formula stage as a least-squares [`Problem`]:
+/// residual = model(θ, sample) − measured.
+pub struct MfStage<'a> {
+    form: Form,
+    base: MfParams<f64>,
+    params: Vec<Param>,
+    /// Key index (in [`MfParams::as_slice`] order) of every θ entry.
+    keys: Vec<usize>,
+    conds: &'a [Conditions],
+    meas: &'a [f64],
+    channel: Channel,
+    weights: Option<Vec<f64>>,
+    /// Threads for evaluation (results do not depend on it).
+    pub threads: usize,
+}
+
+/// The parameter table of a stage, starting from `base`: camber terms held
+/// when `hold_camber`, pressure terms when `hold_pressure`; the start value
+/// is clamped into the bounds (widening them if the start lies outside, so a
+/// start tyre is never changed without a fit).
+pub fn stage_params(
+    kind: StageKind,
+    base: &MfParams<f64>,
+    hold_camber: bool,
+    hold_pressure: bool,
+) -> Vec<Param> {
+    kind.table()
+        .iter()
+        .filter_map(|&(name, lo, hi, cam, pre)| {
+            let v = base.get(name)?;
+            let mut p = Param::new(name, v, lo.min(v), hi.max(v));
+            if (cam && hold_camber) || (pre && hold_pressure) {
+                p = p.fixed();
+            }
+            Some(p)
+        })
+        .collect()
+}
+
+impl<'a> MfStage<'a> {
+    /// A stage over `channel` of `data` (channel number `k` of the data).
+    pub fn new(
+        form: Form,
+        base: &MfParams<f64>,
+        params: Vec<Param>,
+        data: &'a StageData,
+        k: usize,
+        channel: Channel,
+    ) -> crate::Result<MfStage<'a>> {
+        let keys = params
+            .iter()
+            .map(|p| {
+                key_index(&p.name).ok_or_else(|| {
+                    crate::Error::Input(format!("fit: '{}' is not a .tir key", p.name))
+                })
+            })
+            .collect::<crate::Result<Vec<_>>>()?;
+        let meas = data.meas.get(k).ok_or_else(|| {
+            crate::Error::Input(format!("fit: the stage data have no channel {k}"))
+        })?;
+        Ok(MfStage {
+            form,
+            base: base.clone(),
+            params,
+            keys,
+            conds: &data.conds,
+            meas,
+            channel,
+            weights: None,
+            threads: 1,
+        })
+    }
+
+    /// Weight every residual by `w` (1/σ² of the channel when stacking).
+    pub fn with_weight(mut self, w: f64) -> Self {
+        self.weights = (w != 1.0).then(|| vec![w; self.meas.len()]);
+        self
+    }
+
+    /// Evaluate on `threads` threads.
+    pub fn with_threads(mut self, threads: usize) -> Self {
+        self.threads = threads.max(1);
+        self
+    }
+
+    /// The base parameters with θ written in.
+    pub fn params_at(&self, theta: &[f64]) -> MfParams<f64> {
+        let mut p = self.base.clone();
+        let s = p.as_mut_slice();
+        for (&k, &v) in self.keys.iter().zip(theta) {
+            s[k] = v;
+        }
+        p
+    }
+
+    /// The channel simulated at every stage sample.
+    pub fn simulate(&self, theta: &[f64]) -> Vec<f64> {
+        let model = Model::new(self.params_at(theta), self.form);
+        self.conds
+            .iter()
+            .map(|c| self.channel.of(&model.solve(c)))
+            .collect()
+    }
+}
+
+impl Problem for MfStage<'_> {
+    fn params(&self) -> &[Param] {
+        &self.params
+    }
+    fn n_residuals(&self) -> usize {
+        self.meas.len()
+    }
+    fn residuals(&self, theta: &[f64], r: &mut [f64]) {
+        let model = Model::new(self.params_at(theta), self.form);
+        par_rows(self.threads, 0, r, None, &|first, r: &mut [f64], _| {
+            for (k, rk) in r.iter_mut().enumerate() {
+                let i = first + k;
+                *rk = self.channel.of(&model.solve(&self.conds[i])) - self.meas[i];
+            }
+        });
+    }
+    fn jacobian(
+        &self,
+        theta: &[f64],
+        cols: &[usize],
+        r: &mut [f64],
+        jac: &mut DMatrixViewMut<f64>,
+    ) {
+        let p = self.params_at(theta);
+        if cols.is_empty() {
+            self.residuals(theta, r);
+            return;
+        }
+        for (pass, chunk) in cols.chunks(LANES).enumerate() {
+            // Seed lane l with the key of cols[pass·LANES + l].
+            let mut lane_of = [usize::MAX; LANES];
+            for (l, &c) in chunk.iter().enumerate() {
+                lane_of[l] = self.keys[c];
+            }
+            let pd: MfParams<Lanes> = p.map(|i, v| match lane_of.iter().position(|&k| k == i) {
+                Some(l) => Lanes::new(v, Derivative::derivative_generic(Const::<LANES>, U1, l)),
+                None => Lanes::from(v),
+            });
+            let model = Model::new(pd, self.form);
+            let width = chunk.len();
+            let col0 = pass * LANES;
+            par_rows(
+                self.threads,
+                0,
+                r,
+                Some(jac),
+                &|first, r: &mut [f64], jac| {
+                    let Some(jac) = jac else { return };
+                    for (k, rk) in r.iter_mut().enumerate() {
+                        let i = first + k;
+                        let y = self.channel.of(&model.solve(&self.conds[i]));
+                        if pass == 0 {
+                            *rk = y.re - self.meas[i];
+                        }
+                        let g = y.eps.unwrap_generic(Const::<LANES>, U1);
+                        for l in 0..width {
+                            jac[(k, col0 + l)] = g[l];
+                        }
+                    }
+                },
+            );
+        }
+    }
+    fn weights(&self) -> Option<&[f64]> {
+        self.weights.as_deref()
+    }
+}

@@ -56,7 +56,8 @@
 //! moves by at most 5 % of z_ss per sub-step (at most 32, deterministic).
 //!
 //! Parameters may come from a `[LUGRE]` section of the `.tir`
-//! ([`LuGreParams::from_tir_text`], [`LuGreParams::to_tir_section`]); keys
+//! ([`LuGreParams::from_tyre_params`] / [`LuGreParams::write_to`] through the
+//! `.tir` custom-section API; `from_tir_text`/`to_tir_section` for raw text); keys
 //! (SI): `SIGMA0X`, `SIGMA0Y` (1/m), `SIGMA1X`, `SIGMA1Y` (s/m), `SIGMA2` (s/m),
 //! `MUC`, `MUS` (–), `VS` (m/s), `DELTA` (–, Stribeck exponent), `KAPPA_L`
 //! (1/m), `BREAKAWAY` (–). A zero SIGMA* means "derive the default". `MUC` > 0 selects the
@@ -124,6 +125,9 @@ impl Default for LuGreParams {
         }
     }
 }
+
+/// Name of the `.tir` section holding the LuGre parameters.
+pub const SECTION: &str = "LUGRE";
 
 /// Names of the `[LUGRE]` keys, in writer order.
 pub const LUGRE_KEYS: [&str; 11] = [
@@ -237,9 +241,45 @@ impl LuGreParams {
         })
     }
 
-    /// The `[LUGRE]` section as `.tir` text (for the writer).
-    pub fn to_tir_section(&self) -> String {
-        let vals = [
+    /// From the `[LUGRE]` section of a read tyre file (the `.tir` custom-section
+    /// API, [`crate::tir::TyreParams::extra_number`]); defaults when absent. A
+    /// key that is present but not a number is refused, naming the file and key.
+    pub fn from_tyre_params(t: &crate::tir::TyreParams) -> crate::Result<Self> {
+        for key in LUGRE_KEYS {
+            if t.extra(SECTION, key).is_some() && t.extra_number(SECTION, key).is_none() {
+                return Err(crate::Error::Tir {
+                    file: t.source.clone(),
+                    line: 0,
+                    key: key.to_string(),
+                    message: format!("[LUGRE] {key}: expected a number"),
+                });
+            }
+        }
+        LuGreParams::from_lookup(|k| t.extra_number(SECTION, k)).map_err(|e| match e {
+            crate::Error::Tir {
+                line, key, message, ..
+            } => crate::Error::Tir {
+                file: t.source.clone(),
+                line,
+                key,
+                message,
+            },
+            other => other,
+        })
+    }
+
+    /// Store these parameters as the `[LUGRE]` section of `t` (the `.tir`
+    /// writer then writes it; [`LuGreParams::from_tyre_params`] reads it back).
+    pub fn write_to(&self, t: &mut crate::tir::TyreParams) {
+        let sec = t.extra_section(SECTION);
+        for (k, v) in LUGRE_KEYS.iter().zip(self.values()) {
+            sec.set(k, v);
+        }
+    }
+
+    /// Values in [`LUGRE_KEYS`] order (MUC = 0 unless Stribeck).
+    fn values(&self) -> [f64; 11] {
+        [
             self.sigma0x,
             self.sigma0y,
             self.sigma1x,
@@ -255,7 +295,12 @@ impl LuGreParams {
             self.delta,
             self.kappa_l,
             self.breakaway,
-        ];
+        ]
+    }
+
+    /// The `[LUGRE]` section as `.tir` text (for the writer).
+    pub fn to_tir_section(&self) -> String {
+        let vals = self.values();
         let mut s = String::from("[LUGRE]\n");
         for (k, v) in LUGRE_KEYS.iter().zip(vals) {
             s.push_str(&format!("{k} = {v:e}\n"));

@@ -37,7 +37,22 @@ fn step_path_does_not_allocate() {
     tyrekit::tir::TyreParams::builtin()
         .write(&dir.join("tyre.tir"))
         .unwrap();
+    // Every transient model (and the non-linear relaxation variant), from
+    // VXLOW up and below it (the low-speed offset correction, LuGre sub-steps).
+    for (kind, nonlinear) in [
+        ("steady", false),
+        ("relaxation", false),
+        ("relaxation", true),
+        ("lugre", false),
+    ] {
+        steps_without_allocation(&dir, kind, nonlinear);
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+fn steps_without_allocation(dir: &std::path::Path, kind: &str, nonlinear: bool) {
     let name = CString::new("alloc").unwrap();
+    let kind_c = CString::new(kind).unwrap();
     let guid = CString::new(tyrekit::fmi::GUID).unwrap();
     let res = CString::new(format!("file://{}", dir.display())).unwrap();
     let ok = Fmi2Status::Ok;
@@ -52,6 +67,16 @@ fn step_path_does_not_allocate() {
             0,
         );
         assert!(!c.is_null());
+        let kv = [kind_c.as_ptr()];
+        assert_eq!(
+            fmi2SetString(c, [vr::TRANSIENT].as_ptr(), 1, kv.as_ptr()),
+            ok
+        );
+        let nl = [i32::from(nonlinear)];
+        assert_eq!(
+            fmi2SetBoolean(c, [vr::NONLINEAR].as_ptr(), 1, nl.as_ptr()),
+            ok
+        );
         assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), ok);
         assert_eq!(fmi2EnterInitializationMode(c), ok);
         assert_eq!(fmi2ExitInitializationMode(c), ok);
@@ -60,7 +85,8 @@ fn step_path_does_not_allocate() {
         let mut y = [0.0; 7];
         let before = ALLOCATIONS.load(Ordering::Relaxed);
         for k in 0..1000 {
-            let u = [20.0, 0.001 * k as f64, 63.0, 4000.0, 0.0];
+            let vx = if k < 500 { 20.0 } else { 0.5 };
+            let u = [vx, 0.001 * k as f64, vx * 3.15, 4000.0, 0.0];
             assert_eq!(
                 fmi2SetReal(c, inputs.as_ptr(), inputs.len(), u.as_ptr()),
                 ok
@@ -74,7 +100,10 @@ fn step_path_does_not_allocate() {
         let after = ALLOCATIONS.load(Ordering::Relaxed);
         assert!(y[1].is_finite());
         fmi2FreeInstance(c);
-        assert_eq!(after - before, 0, "allocations in 1000 steps");
+        assert_eq!(
+            after - before,
+            0,
+            "allocations in 1000 steps (transient {kind}, nonlinear {nonlinear})"
+        );
     }
-    let _ = std::fs::remove_dir_all(dir);
 }

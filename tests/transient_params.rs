@@ -100,16 +100,31 @@ fn mf52_relaxation_lengths_from_ptx_pty() {
 }
 
 /// Turn slip (use mode with turn slip on) lags with σα: φ'(t) = φt·(1 − e^{−Vt/σα}).
+/// σα is the MF's at the same inputs: with turn slip on, the cornering
+/// stiffness Kyα (hence σα = Kyα/Cy) carries the turn-slip reduction ζ3, so
+/// σα at φt = 0.05 1/m is not the one at φt = 0.
 #[test]
 fn turn_slip_lags_with_lateral_relaxation_length() {
     let tyre = Tyre::builtin();
-    let (_, sy) = mf_sigmas(&tyre);
+    let mode = UseMode::from_code(112).unwrap();
+    let (v, phit, dt) = (15.0, 0.05, 1e-3);
+    let sy = tyre
+        .evaluate(
+            &tyrekit::mf::MfInput {
+                fz: FZ,
+                vx: v,
+                phit,
+                ..Default::default()
+            },
+            mode,
+        )
+        .sigmay;
+    assert!(sy > 0.0, "MF gives no sigmay: {sy}");
     let mut m = TransientModel::new(TransientConfig {
         kind: TransientKind::Relaxation,
         input_mode: InputMode::Slips,
-        use_mode: UseMode::from_code(112).unwrap(),
+        use_mode: mode,
     });
-    let (v, phit, dt) = (15.0, 0.05, 1e-3);
     for k in 1..=200 {
         let mut inp = slips(v, 0.0, 0.0);
         inp.phit = phit;

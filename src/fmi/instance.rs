@@ -32,7 +32,8 @@ use super::vars::{
 use crate::mf::{Tyre, UseMode};
 use crate::tir::TyreSide;
 use crate::transient::{
-    InputMode, TransientConfig, TransientKind, TransientModel, WheelInput, WheelOutput,
+    InputMode, LuGreParams, TransientConfig, TransientKind, TransientModel, TransientOptions,
+    WheelInput, WheelOutput,
 };
 use std::ffi::CString;
 use std::path::{Path, PathBuf};
@@ -154,6 +155,9 @@ pub struct Instance {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Derived {
     pub config: TransientConfig,
+    /// Non-linear relaxation (parameter `nonlinear`) and the LuGre parameters
+    /// of the tyre file's `[LUGRE]` section (defaults without one).
+    pub options: TransientOptions,
     pub mirror: bool,
 }
 
@@ -202,11 +206,17 @@ pub fn derive(values: &Values, tyre: &Tyre) -> Result<Derived, String> {
         Some(_) if file_side == TyreSide::Symmetric => false,
         Some(w) => w != file_side,
     };
+    let lugre = LuGreParams::from_tyre_params(tyre.params())
+        .map_err(|e| format!("transient = \"{kind_s}\": [LUGRE] section: {e}"))?;
     Ok(Derived {
         config: TransientConfig {
             kind,
             input_mode,
             use_mode,
+        },
+        options: TransientOptions {
+            nonlinear: values.booleans[boolean::NONLINEAR],
+            lugre,
         },
         mirror,
     })
@@ -280,6 +290,7 @@ impl Sim {
     /// Install derived settings and the calculated parameters.
     pub fn apply(&mut self, d: Derived) {
         self.model.config = d.config;
+        self.model.options = d.options;
         self.mirror = d.mirror;
         let p = &self.loaded.tyre.params().p;
         self.values.reals[real::R0] = p.unloaded_radius;
@@ -679,7 +690,8 @@ impl Instance {
                 self.sim.values.booleans[v.slot] = *x != 0;
             }
         }
-        Ok(())
+        // A Boolean parameter (nonlinear) changes the derived options.
+        self.reconfigure()
     }
 
     /// fmi2GetString: pointers into the instance, valid until the next call.
@@ -736,7 +748,8 @@ impl Instance {
     /// Install a complete state (fmi2SetFMUstate); checked before anything changes.
     pub fn restore(&mut self, sim: &Sim) -> Result<(), String> {
         let d = derive(&sim.values, &sim.loaded.tyre)?;
-        if d.config != sim.model.config || d.mirror != sim.mirror {
+        if d.config != sim.model.config || d.options != sim.model.options || d.mirror != sim.mirror
+        {
             return Err("FMU state is inconsistent with its own parameters".into());
         }
         self.sim.clone_from(sim);

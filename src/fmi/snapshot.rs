@@ -214,7 +214,7 @@ pub fn deserialize(inst: &Instance, bytes: &[u8]) -> Result<Sim, String> {
     }
     let loaded = inst.tyre_for(values.string(string::TYRE_FILE))?;
     let d = derive(&values, &loaded.tyre)?;
-    let mut model = crate::transient::TransientModel::new(d.config);
+    let mut model = crate::transient::TransientModel::with_options(d.config, d.options);
     model.state.x = x;
     Ok(Sim {
         phase,

@@ -41,6 +41,7 @@ pub const BOUND_VARIABLES: &[(&str, &str, &str)] = &[
     ("transient", "String", "parameter"),
     ("use_mode", "Integer", "parameter"),
     ("side", "String", "parameter"),
+    ("nonlinear", "Boolean", "parameter"),
     // calculated parameters
     ("R0", "Real", "calculatedParameter"),
     ("Fz0", "Real", "calculatedParameter"),

@@ -18,17 +18,22 @@
 //! * [`LuGreFriction::MagicFormula`] (default): g is derived from the Magic
 //!   Formula curve of the same tyre, per direction, so that the steady state
 //!   (ż = 0: F_i = Fz·σ0_i·vr_i/θ_i) equals the MF force at the same
-//!   (combined) slips. The MF's force at zero slip F_i,0 (shifts SH/SV,
-//!   camber thrust, from the zero-slip probe at the actual speed) is carried
-//!   directly, F_i = F_i,0 + Fz·(σ0_i·z_i + …), and the bristles carry the
-//!   slip-generated part ΔF_i = F_i,MF(κ, α) − F_i,0, which has the sign of
-//!   vr_i for any MF curve through the origin of ΔF:
+//!   (combined) slips. The part of the MF force that no sliding in direction
+//!   i generates is carried directly: F_x,0 = Fx,MF(0, α) and
+//!   F_y,0 = Fy,MF(κ, 0) (the shifts SH/SV and camber thrust at zero slip,
+//!   plus the combined-slip cross terms, e.g. SVyκ: a braked tyre running
+//!   straight has a lateral force with no lateral sliding). The bristles carry
+//!   ΔF_i = F_i,MF(κ, α) − F_i,0, which is zero at zero own slip and has the
+//!   sign of vr_i for a monotone curve:
 //!   θ_i = Fz·σ0_i·|vr_i|/(|ΔF_i|·S(‖vr‖)), where the Stribeck factor
 //!   S = 1 + (μs/μc − 1)·exp(−(‖vr‖/vs)^δ) is 1 by default. Steady state:
 //!   F_i = F_i,0 + ΔF_i = F_i,MF exactly. Combined-slip coupling is that of the
 //!   MF (its combined-slip weights). Below VXLOW, where the MF evaluation runs
 //!   at a raised speed, ΔF is taken against that evaluation's own zero-slip
-//!   force, while F_i,0 keeps the MF's low-speed reduction of its shifts.
+//!   force, while F_i,0 keeps the MF's low-speed reduction of its shifts, and
+//!   the cross terms fade out with the low-speed weight (1 − w) (at standstill
+//!   the kinematic slips are meaningless: a creeping wheel must not get SVyκ).
+//!   Cost: up to two extra forces evaluations per step (Fx(0, α), Fy(κ, 0)).
 //! * [`LuGreFriction::Stribeck`]: the classical isotropic Stribeck curve
 //!   g(‖vr‖) = μc + (μs − μc)·exp(−(‖vr‖/vs)^δ) with θ_i = σ0_i‖vr‖/g + κ_L|ΩRe|.
 //!
@@ -51,7 +56,8 @@
 //! moves by at most 5 % of z_ss per sub-step (at most 32, deterministic).
 //!
 //! Parameters may come from a `[LUGRE]` section of the `.tir`
-//! ([`LuGreParams::from_tir_text`], [`LuGreParams::to_tir_section`]); keys
+//! ([`LuGreParams::from_tyre_params`] / [`LuGreParams::write_to`] through the
+//! `.tir` custom-section API; `from_tir_text`/`to_tir_section` for raw text); keys
 //! (SI): `SIGMA0X`, `SIGMA0Y` (1/m), `SIGMA1X`, `SIGMA1Y` (s/m), `SIGMA2` (s/m),
 //! `MUC`, `MUS` (–), `VS` (m/s), `DELTA` (–, Stribeck exponent), `KAPPA_L`
 //! (1/m), `BREAKAWAY` (–). A zero SIGMA* means "derive the default". `MUC` > 0 selects the
@@ -60,7 +66,7 @@
 //!
 //! Must never: allocate in `step`, divide by a speed or a force without a guard.
 
-use super::{mf_at, relax_exact, Slip, StepCtx, TransientState, WheelOutput, SLOT_X, SLOT_Y};
+use super::{relax_exact, Slip, StepCtx, TransientState, WheelOutput, SLOT_X, SLOT_Y};
 
 /// Which friction function the bristles saturate at.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -119,6 +125,9 @@ impl Default for LuGreParams {
         }
     }
 }
+
+/// Name of the `.tir` section holding the LuGre parameters.
+pub const SECTION: &str = "LUGRE";
 
 /// Names of the `[LUGRE]` keys, in writer order.
 pub const LUGRE_KEYS: [&str; 11] = [
@@ -232,9 +241,45 @@ impl LuGreParams {
         })
     }
 
-    /// The `[LUGRE]` section as `.tir` text (for the writer).
-    pub fn to_tir_section(&self) -> String {
-        let vals = [
+    /// From the `[LUGRE]` section of a read tyre file (the `.tir` custom-section
+    /// API, [`crate::tir::TyreParams::extra_number`]); defaults when absent. A
+    /// key that is present but not a number is refused, naming the file and key.
+    pub fn from_tyre_params(t: &crate::tir::TyreParams) -> crate::Result<Self> {
+        for key in LUGRE_KEYS {
+            if t.extra(SECTION, key).is_some() && t.extra_number(SECTION, key).is_none() {
+                return Err(crate::Error::Tir {
+                    file: t.source.clone(),
+                    line: 0,
+                    key: key.to_string(),
+                    message: format!("[LUGRE] {key}: expected a number"),
+                });
+            }
+        }
+        LuGreParams::from_lookup(|k| t.extra_number(SECTION, k)).map_err(|e| match e {
+            crate::Error::Tir {
+                line, key, message, ..
+            } => crate::Error::Tir {
+                file: t.source.clone(),
+                line,
+                key,
+                message,
+            },
+            other => other,
+        })
+    }
+
+    /// Store these parameters as the `[LUGRE]` section of `t` (the `.tir`
+    /// writer then writes it; [`LuGreParams::from_tyre_params`] reads it back).
+    pub fn write_to(&self, t: &mut crate::tir::TyreParams) {
+        let sec = t.extra_section(SECTION);
+        for (k, v) in LUGRE_KEYS.iter().zip(self.values()) {
+            sec.set(k, v);
+        }
+    }
+
+    /// Values in [`LUGRE_KEYS`] order (MUC = 0 unless Stribeck).
+    fn values(&self) -> [f64; 11] {
+        [
             self.sigma0x,
             self.sigma0y,
             self.sigma1x,
@@ -250,7 +295,12 @@ impl LuGreParams {
             self.delta,
             self.kappa_l,
             self.breakaway,
-        ];
+        ]
+    }
+
+    /// The `[LUGRE]` section as `.tir` text (for the writer).
+    pub fn to_tir_section(&self) -> String {
+        let vals = self.values();
         let mut s = String::from("[LUGRE]\n");
         for (k, v) in LUGRE_KEYS.iter().zip(vals) {
             s.push_str(&format!("{k} = {v:e}\n"));
@@ -307,15 +357,35 @@ pub(crate) fn step(c: &StepCtx, p: &LuGreParams, st: &mut TransientState, dt: f6
     let s1y = pos(p.sigma1y, c.props.damp_y_full / fz);
     let transport = p.kappa_l * c.omega_re.abs();
     // Steady MF at the kinematic slips (also the moments and μ outputs).
-    let o = mf_at(c.tyre, &c.base, c.mode, Slip::of(&c.kin), c.s);
-    // Force at zero slip (MF mode only): carried directly, not by the bristles.
+    let o = c.forces(&c.base, Slip::of(&c.kin));
+    // Force not generated by sliding in its own direction (MF mode only):
+    // carried directly, not by the bristles.
     // ΔF is taken against the zero-slip force of the same (raised-speed)
     // evaluation, so it is zero at zero slip at every speed.
+    // The direct part of each direction is the MF force with that direction's
+    // own slip removed: Fx(0, α) and Fy(κ, 0) (at zero slip the shifts and
+    // camber thrust; with the other slip also the combined-slip cross terms,
+    // e.g. SVyκ, the lateral force of a braked tyre running straight, which no
+    // lateral sliding could generate). Below VXLOW the cross terms fade out
+    // with the low-speed weight (the kinematic slips lose their meaning there).
     let (f0x, f0y, b0x, b0y) = match p.friction {
         LuGreFriction::MagicFormula => {
-            let (f0x, f0y) = (c.s * c.props.fx0, c.s * c.props.fy0);
             let (cx, cy) = c.offset_correction();
-            (f0x, f0y, f0x - cx, f0y - cy)
+            let (zx, zy) = (c.s * c.props.fx0 - cx, c.s * c.props.fy0 - cy);
+            let k = &c.kin;
+            let fx_a = if k.tan_alpha == 0.0 {
+                zx
+            } else {
+                c.forces(&c.base, Slip::new(0.0, k.tan_alpha)).fx
+            };
+            let fy_k = if k.kappa == 0.0 {
+                zy
+            } else {
+                c.forces(&c.base, Slip::new(k.kappa, 0.0)).fy
+            };
+            let keep = 1.0 - c.props.weight;
+            let (b0x, b0y) = (zx + keep * (fx_a - zx), zy + keep * (fy_k - zy));
+            (b0x + cx, b0y + cy, b0x, b0y)
         }
         LuGreFriction::Stribeck => (0.0, 0.0, 0.0, 0.0),
     };

@@ -32,8 +32,11 @@
 //! 2. [`Tyre::forces`] at the slips the model uses. For the transient models
 //!    the MF sees a forward speed max(|Vx|, VXLOW) and κ = −Vsx/|Vx|: they
 //!    do low speed and direction themselves (MFeval's steady low-speed slip
-//!    reduction would remove the standstill hold). `Steady` calls the MF as is
-//!    (κ with the sign of Vx, as MFeval expects for reversing).
+//!    reduction would remove the standstill hold); reversing (from
+//!    velocities) they mirror it, κ_MF = −κ, Fx = −Fx_MF (`StepCtx::forces`),
+//!    so braking backwards uses the braking branch of an asymmetric curve.
+//!    `Steady` calls the MF as is (κ with the sign of Vx, as MFeval expects
+//!    for reversing).
 //! 3. Below VXLOW only: the forces at zero slip at the raised speed, so that
 //!    the MF's force at zero slip (shifts, camber thrust) keeps the MF's own
 //!    low-speed reduction (`StepCtx::offset_correction`).
@@ -565,9 +568,27 @@ pub(crate) struct StepCtx<'a> {
     pub omega_re: f64,
     /// Whether the force evaluation runs at a raised speed (|Vx| < VXLOW).
     pub floored: bool,
+    /// Rolling direction (−1 reversing from velocities, else +1): see [`StepCtx::forces`].
+    pub dir: f64,
 }
 
 impl StepCtx<'_> {
+    /// The transient models' force evaluation at slips `sl` (κ = −Vsx/|Vx|):
+    /// the forward-rolling MF, mirrored when reversing — κ_MF = dir·κ and
+    /// Fx = dir·Fx_MF — so that braking while reversing uses the braking
+    /// branch of the curve (the MF's brake/drive asymmetry, SHx, SVx), as a
+    /// tyre turned around would, and as MFeval does with κ of the sign of Vx.
+    #[inline]
+    pub fn forces(&self, base: &MfInput, sl: Slip) -> Forces {
+        let sl = Slip {
+            kappa: self.dir * sl.kappa,
+            ..sl
+        };
+        let mut o = mf_at(self.tyre, base, self.mode, sl, self.s);
+        o.fx *= self.dir;
+        o
+    }
+
     /// Low-speed offset correction (N): the MF's force at zero slip at the
     /// actual speed (the probe, with the MF's own low-speed reduction of its
     /// shifts) minus that at the raised speed of the force evaluation. Zero
@@ -578,7 +599,7 @@ impl StepCtx<'_> {
         if !self.floored {
             return (0.0, 0.0);
         }
-        let f = mf_at(self.tyre, &self.base, self.mode, Slip::default(), self.s);
+        let f = self.forces(&self.base, Slip::default());
         let d = |p: f64, f: f64| {
             let x = self.s * p - f;
             if x.is_finite() {
@@ -666,6 +687,11 @@ impl TransientModel {
             fz,
             omega_re: inp.omega * props.re,
             floored: fbase.vx != base.vx,
+            dir: if self.config.input_mode == InputMode::Velocities && inp.vx < 0.0 {
+                -1.0
+            } else {
+                1.0
+            },
         };
         let mut next = self.state;
         let mut out = if fz <= FZ_OFF {
@@ -706,7 +732,7 @@ impl TransientModel {
                         b.phit = next.x[SLOT_PHI];
                     }
                     let sl = Slip::new(k, t);
-                    let mut o = mf_at(tyre, &b, mode, sl, s);
+                    let mut o = ctx.forces(&b, sl);
                     let (cx, cy) = ctx.offset_correction();
                     o.fx += cx;
                     o.fy += cy;
@@ -830,7 +856,7 @@ fn inst_sigma(c: &StepCtx, k: f64, t: f64) -> (f64, f64) {
     const H: f64 = 1e-5;
     let mut mi = c.base;
     let f = |mi: &mut MfInput, kk: f64, tt: f64| {
-        let o = mf_at(c.tyre, mi, c.mode, Slip::new(kk, tt), c.s);
+        let o = c.forces(mi, Slip::new(kk, tt));
         (o.fx, o.fy)
     };
     let f0 = f(&mut mi, k, t);

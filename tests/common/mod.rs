@@ -180,6 +180,26 @@ pub fn re(tyre: &Tyre, vx: f64) -> f64 {
     }
 }
 
+/// Spin rate Ω at which the wheel at speed vx (> 0) has slip ratio κ, i.e.
+/// Ω·Re(Ω) = vx·(1 + κ), with the MF's Re at that Ω (fixed point; Re varies
+/// weakly with Ω, so it converges in a few iterations).
+pub fn omega_for(tyre: &Tyre, vx: f64, kappa: f64) -> f64 {
+    let mut om = vx * (1.0 + kappa) / re(tyre, vx);
+    for _ in 0..50 {
+        let o = tyre.evaluate(
+            &MfInput {
+                fz: FZ,
+                vx,
+                omega: om,
+                ..Default::default()
+            },
+            UseMode::default(),
+        );
+        om = vx * (1.0 + kappa) / o.re;
+    }
+    om
+}
+
 /// Least-squares amplitude and phase (rad) of `y` against sin(ωt): y ≈ a·sin(ωt + φ) + c.
 pub fn fit_sine(t: &[f64], y: &[f64], w: f64) -> (f64, f64) {
     // Normal equations for [sin, cos, 1].

@@ -122,7 +122,8 @@ impl TruthModel for Relaxation {
 
 /// LuGre dynamic friction (bristle hysteresis): this project's transient
 /// LuGre model (Canudas de Wit et al. 2003, average lumped) driven with the
-/// rig's prescribed slips.
+/// rig's prescribed slips. It has no strength yet: [`concealed`] ignores
+/// the level for it (default LuGre parameters derived from the MF).
 pub struct LuGre {
     pub inner: SteadyMf,
     pub model: TransientModel,

@@ -101,6 +101,22 @@ pub struct Finding {
     pub detail: String,
 }
 
+impl Finding {
+    /// A finding from its observed statistic and null distribution (not yet adjusted).
+    fn new(name: &'static str, obs: f64, null: &[f64], detail: String) -> Finding {
+        let (z, p) = significance(obs, null);
+        Finding {
+            name,
+            statistic: obs,
+            z,
+            p_value: p,
+            p_adjusted: p,
+            significant: false,
+            detail,
+        }
+    }
+}
+
 /// Accumulated frictional energy (J) per sample from measured forces and slip
 /// speeds: E = ∫ |Fx·Vsx| + |Fy·Vsy| dt, Vsx = κ·|Vx|, Vsy = tan α·|Vx|
 /// (NaN terms and gaps contribute nothing).
@@ -378,16 +394,12 @@ pub fn locate(d: &Residuals, o: &LocateOptions) -> Vec<Finding> {
                 stat(&perm)
             })
             .collect();
-        let (z, p) = significance(obs, &null);
         let (lo, hi) = extremes(&x, &b);
-        out.push(Finding {
+        out.push(Finding::new(
             name,
-            statistic: obs,
-            z,
-            p_value: p,
-            p_adjusted: p,
-            significant: false,
-            detail: format!(
+            obs,
+            &null,
+            format!(
                 "relative force scale error {:+.2} % at {name} {:.4}, {:+.2} % at {:.4} ({} segments)",
                 100.0 * lo.1,
                 lo.0,
@@ -395,7 +407,7 @@ pub fn locate(d: &Residuals, o: &LocateOptions) -> Vec<Finding> {
                 hi.0,
                 x.len()
             ),
-        });
+        ));
     }
 
     // Sample level.
@@ -414,16 +426,7 @@ pub fn locate(d: &Residuals, o: &LocateOptions) -> Vec<Finding> {
                     stat(&buf)
                 })
                 .collect();
-            let (z, p) = significance(obs, &null);
-            out.push(Finding {
-                name,
-                statistic: obs,
-                z,
-                p_value: p,
-                p_adjusted: p,
-                significant: false,
-                detail,
-            });
+            out.push(Finding::new(name, obs, &null, detail));
         };
         let region_means = {
             let (mut s, mut n) = ([0.0; 3], [0usize; 3]);

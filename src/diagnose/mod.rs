@@ -9,5 +9,7 @@
 //! statistics look at physical signatures: sweep direction, load, time,
 //! frictional energy), or panic on a recording with missing channels.
 
+pub mod candidate;
 pub mod locate;
 pub mod replay;
+pub mod report;

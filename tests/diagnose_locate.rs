@@ -175,8 +175,8 @@ fn planted_load_trend_is_found_first() {
     // Friction scale error growing with load: −2 % per nominal load.
     let s = synth();
     let mut r = noise(s.sim.len(), 20.0, 0.9, 8);
-    for i in 0..r.len() {
-        r[i] += -0.02 * (s.fz[i] / 4000.0 - 1.0) * s.sim[i];
+    for (i, x) in r.iter_mut().enumerate() {
+        *x += -0.02 * (s.fz[i] / 4000.0 - 1.0) * s.sim[i];
     }
     let f = run(&s, &r, 499);
     let t = top(&f);
@@ -189,8 +189,8 @@ fn planted_time_drift_is_found_first() {
     // Grip fading within each run: −0.3 % of the force per second.
     let s = synth();
     let mut r = noise(s.sim.len(), 20.0, 0.9, 9);
-    for i in 0..r.len() {
-        r[i] += -0.003 * s.t[i] * s.sim[i];
+    for (i, x) in r.iter_mut().enumerate() {
+        *x += -0.003 * s.t[i] * s.sim[i];
     }
     let f = run(&s, &r, 499);
     let t = top(&f);

@@ -49,16 +49,25 @@ pub trait Candidate {
     ) -> Result<Box<dyn Fitted>>;
 }
 
+/// A force channel: its name, simulated value and measured value.
+pub type Channel = (
+    &'static str,
+    fn(&Forces) -> f64,
+    fn(&crate::data::Sample) -> f64,
+);
+
+/// The channels the diagnosis scores: Fx, Fy, Mz.
+pub const CHANNELS: [Channel; 3] = [
+    ("FX", |f| f.fx, |s| s.fx),
+    ("FY", |f| f.fy, |s| s.fy),
+    ("MZ", |f| f.mz, |s| s.mz),
+];
+
 /// Weighted SSE of Fx, Fy, Mz over masked samples (each channel normalised by
 /// its measured variance over the mask; channels the recording lacks skipped).
 pub fn sse(rec: &Recording, sim: &[Forces], mask: &[bool]) -> f64 {
-    let chans: [(fn(&Forces) -> f64, fn(&crate::data::Sample) -> f64); 3] = [
-        (|f| f.fx, |s| s.fx),
-        (|f| f.fy, |s| s.fy),
-        (|f| f.mz, |s| s.mz),
-    ];
     let mut total = 0.0;
-    for (fs, fm) in chans {
+    for (_, fs, fm) in CHANNELS {
         let (mut e, mut m1, mut m2, mut n) = (0.0, 0.0, 0.0, 0.0);
         for ((s, f), &k) in rec.samples.iter().zip(sim).zip(mask) {
             let (y, p) = (fm(s), fs(f));

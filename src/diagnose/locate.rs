@@ -324,7 +324,7 @@ fn hysteresis(w: &Within) -> f64 {
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &s| {
             (l.min(s), h.max(s))
         });
-    if !(hi > lo) {
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
         return 0.0;
     }
     let mut acc = [[0.0f64; 4]; 20];
@@ -359,7 +359,8 @@ pub fn locate(d: &Residuals, o: &LocateOptions) -> Vec<Finding> {
         let i = ((g.start + g.end) / 2).min(d.energy.len().saturating_sub(1));
         d.energy.get(i).copied().unwrap_or(f64::NAN)
     };
-    let covs: [(&'static str, &dyn Fn(&Segment) -> f64); 5] = [
+    type Cov<'c> = (&'static str, &'c dyn Fn(&Segment) -> f64);
+    let covs: [Cov; 5] = [
         ("load", &|g| g.fz),
         ("inclination", &|g| g.gamma),
         ("pressure", &|g| g.p),
@@ -375,7 +376,8 @@ pub fn locate(d: &Residuals, o: &LocateOptions) -> Vec<Finding> {
         }
         let spread = x.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
             - x.iter().cloned().fold(f64::INFINITY, f64::min);
-        if x.len() < 4 || !(spread > 1e-9 * x.iter().map(|v| v.abs()).fold(0.0, f64::max)) {
+        let scale = x.iter().map(|v| v.abs()).fold(0.0, f64::max);
+        if x.len() < 4 || spread.partial_cmp(&(1e-9 * scale)) != Some(std::cmp::Ordering::Greater) {
             continue;
         }
         let stat = |perm: &[usize]| {

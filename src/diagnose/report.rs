@@ -7,7 +7,7 @@
 //!
 //! Must never: name an effect whose held-out improvement is within noise.
 
-use super::candidate::{evaluate, Candidate, NoneCandidate, RelaxationCandidate};
+use super::candidate::{evaluate, Candidate, NoneCandidate, RelaxationCandidate, CHANNELS};
 use super::locate::{frictional_energy, locate, Finding, LocateOptions, Residuals};
 use super::replay::{replay, ReplayOptions};
 use crate::data::Recording;
@@ -23,12 +23,7 @@ pub const MIN_GAIN: f64 = 0.05;
 /// NRMSE per channel (FX, FY, MZ) of `sim` against the recording.
 pub fn nrmse_map(rec: &Recording, sim: &[Forces]) -> Value {
     let mut m = Map::new();
-    let chans: [(&str, fn(&Forces) -> f64, fn(&crate::data::Sample) -> f64); 3] = [
-        ("FX", |f| f.fx, |s| s.fx),
-        ("FY", |f| f.fy, |s| s.fy),
-        ("MZ", |f| f.mz, |s| s.mz),
-    ];
-    for (name, fs, fm) in chans {
+    for (name, fs, fm) in CHANNELS {
         let y: Vec<f64> = rec.samples.iter().map(fm).collect();
         let p: Vec<f64> = sim.iter().map(fs).collect();
         let v = nrmse(&p, &y);

@@ -112,6 +112,8 @@ impl SteadyMf {
 /// Radii with fallbacks when the model reports none (see [`crate::data::slip::model_radii`]).
 pub use crate::data::slip::model_radii as radii;
 
+pub mod effects;
+
 impl TruthModel for SteadyMf {
     fn sample(&mut self, inp: &RigInput, _dt: f64) -> TruthOutput {
         let o = self.tyre.evaluate(&inp.mf, self.mode);

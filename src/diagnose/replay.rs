@@ -1,0 +1,248 @@
+//! replay — a recording's measured inputs (ISO-W, SI) stepped through
+//! [`TransientModel::step`], the code the FMU runs, on the recording's own
+//! time base.
+//!
+//! # Time base and resets
+//! * The step of sample `i` is `dt = t[i] − t[i−1]`; the inputs of sample
+//!   `i` are held over that step (zero-order hold towards the sample, the
+//!   FMU's co-simulation convention) and the outputs at its end are compared
+//!   with sample `i`.
+//! * The model state is reset to rest at the first sample and at every
+//!   **gap**: a non-finite or non-positive time step, or one longer than
+//!   [`ReplayOptions::gap_factor`] times the median sample spacing (the
+//!   warm-up cut, concatenated files, dropped rows). A continuous recording
+//!   is *not* reset at segment starts: the rig runs through its transitions
+//!   without stopping, so the tyre's state carries over physically.
+//! * After a reset, the state is **settled** on the first sample of the run:
+//!   one step of [`ReplayOptions::settle_time`] with that sample's inputs
+//!   held (the transient models integrate exactly, so this is the steady
+//!   state of those inputs). A run that starts mid-sweep thus starts at
+//!   equilibrium, not at an artificial zero deflection.
+//! * A sample whose core inputs (Vx, Fz, α) are missing or refused by the
+//!   model gets NaN outputs and ends its run (the next good sample starts a
+//!   new one). Missing κ, γ, φt read as 0, missing pressure as 0 (= the
+//!   .tir's INFLPRES), missing Ω as (1+κ)·Vx / R0.
+//!
+//! Slips are prescribed ([`InputMode::Slips`]): rigs impose κ and α and
+//! record them; velocities would recompute κ through a model Re that the
+//! rig's own Re definition need not share.
+//!
+//! Must never: allocate per sample beyond the output vectors, or carry a
+//! state across a gap.
+
+use crate::data::Recording;
+use crate::error::Result;
+use crate::mf::{Forces, Tyre, UseMode};
+use crate::transient::{
+    InputMode, TransientConfig, TransientKind, TransientModel, TransientOptions, WheelInput,
+    WheelOutput,
+};
+use std::io::Write;
+
+/// How to replay.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReplayOptions {
+    pub kind: TransientKind,
+    pub use_mode: UseMode,
+    pub options: TransientOptions,
+    /// A step longer than this many median spacings is a gap (reset).
+    pub gap_factor: f64,
+    /// Duration (s) of the settling step after a reset (0: start at rest).
+    pub settle_time: f64,
+}
+
+impl Default for ReplayOptions {
+    fn default() -> Self {
+        ReplayOptions {
+            kind: TransientKind::Steady,
+            use_mode: UseMode::default(),
+            options: TransientOptions::default(),
+            gap_factor: 5.0,
+            settle_time: 5.0,
+        }
+    }
+}
+
+/// The replay of one recording: one output per sample (NaN where the sample
+/// could not be replayed) and the runs between resets.
+#[derive(Clone, Debug, Default)]
+pub struct Replay {
+    pub sim: Vec<Forces>,
+    /// Full step outputs (slips used, μ, slip speeds …), one per sample.
+    pub out: Vec<WheelOutput>,
+    /// Half-open sample ranges replayed without a reset.
+    pub runs: Vec<(usize, usize)>,
+    /// Samples that could not be replayed.
+    pub skipped: usize,
+}
+
+/// Median of the positive finite time steps (NaN when there are none).
+pub fn median_spacing(t: &[f64]) -> f64 {
+    let mut d: Vec<f64> = t
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|d| d.is_finite() && *d > 0.0)
+        .collect();
+    if d.is_empty() {
+        return f64::NAN;
+    }
+    let m = d.len() / 2;
+    *d.select_nth_unstable_by(m, f64::total_cmp).1
+}
+
+/// The model's input for one recorded sample (None when a core input is missing).
+pub fn wheel_input(tyre: &Tyre, s: &crate::data::Sample) -> Option<WheelInput> {
+    if !(s.vx.is_finite() && s.fz.is_finite() && s.alpha.is_finite()) {
+        return None;
+    }
+    let or0 = |x: f64| if x.is_finite() { x } else { 0.0 };
+    let kappa = or0(s.kappa);
+    let omega = if s.omega.is_finite() {
+        s.omega
+    } else {
+        let r0 = tyre.params().p.unloaded_radius;
+        let r0 = if r0.is_finite() && r0 > 0.0 { r0 } else { 0.3 };
+        (1.0 + kappa) * s.vx / r0
+    };
+    Some(WheelInput {
+        vx: s.vx,
+        vy: 0.0,
+        omega,
+        fz: s.fz,
+        gamma: or0(s.gamma),
+        p: or0(s.p),
+        phit: or0(s.phit),
+        mu_scale: 0.0,
+        kappa_in: kappa,
+        alpha_in: s.alpha,
+    })
+}
+
+/// Replay `rec` through `tyre` (see the module docs for time base and resets).
+pub fn replay(rec: &Recording, tyre: &Tyre, opts: &ReplayOptions) -> Result<Replay> {
+    let n = rec.samples.len();
+    let t: Vec<f64> = rec.samples.iter().map(|s| s.time).collect();
+    let h = median_spacing(&t);
+    let max_dt = if h.is_finite() {
+        h * opts.gap_factor.max(1.0)
+    } else {
+        f64::INFINITY
+    };
+    let mut model = TransientModel::with_options(
+        TransientConfig {
+            kind: opts.kind,
+            input_mode: InputMode::Slips,
+            use_mode: opts.use_mode,
+        },
+        opts.options,
+    );
+    let nan = Forces {
+        fx: f64::NAN,
+        fy: f64::NAN,
+        mx: f64::NAN,
+        my: f64::NAN,
+        mz: f64::NAN,
+    };
+    let mut r = Replay {
+        sim: Vec::with_capacity(n),
+        out: Vec::with_capacity(n),
+        runs: Vec::new(),
+        skipped: 0,
+    };
+    let mut run_start: Option<usize> = None;
+    for (i, s) in rec.samples.iter().enumerate() {
+        let dt = if i > 0 { t[i] - t[i - 1] } else { f64::NAN };
+        let gap = !(dt.is_finite() && dt > 0.0 && dt <= max_dt);
+        if gap || run_start.is_none() {
+            if let Some(a) = run_start.take() {
+                r.runs.push((a, i));
+            }
+        }
+        let o = wheel_input(tyre, s).and_then(|inp| {
+            if run_start.is_none() {
+                model.reset();
+                let settle = opts.settle_time.max(0.0);
+                model.step(tyre, &inp, settle).ok()
+            } else {
+                model.step(tyre, &inp, dt).ok()
+            }
+        });
+        match o {
+            Some(o) => {
+                if run_start.is_none() {
+                    run_start = Some(i);
+                }
+                r.sim.push(Forces {
+                    fx: o.fx,
+                    fy: o.fy,
+                    mx: o.mx,
+                    my: o.my,
+                    mz: o.mz,
+                });
+                r.out.push(o);
+            }
+            None => {
+                if let Some(a) = run_start.take() {
+                    r.runs.push((a, i));
+                }
+                r.skipped += 1;
+                r.sim.push(nan);
+                r.out.push(WheelOutput {
+                    fx: f64::NAN,
+                    fy: f64::NAN,
+                    mx: f64::NAN,
+                    my: f64::NAN,
+                    mz: f64::NAN,
+                    ..Default::default()
+                });
+            }
+        }
+    }
+    if let Some(a) = run_start {
+        r.runs.push((a, n));
+    }
+    Ok(r)
+}
+
+/// Write the replay CSV: `time,Fx,Fy,Mz,Fx_sim,Fy_sim,Mz_sim`, then
+/// `Mx,My,Mx_sim,My_sim` when the recording has Mx / My (ISO-W, SI).
+pub fn write_csv(rec: &Recording, rp: &Replay, w: impl std::io::Write) -> std::io::Result<()> {
+    let has_mx = rec.has("Mx");
+    let has_my = rec.has("My");
+    let mut w = std::io::BufWriter::new(w);
+    write!(w, "time,Fx,Fy,Mz,Fx_sim,Fy_sim,Mz_sim")?;
+    if has_mx {
+        write!(w, ",Mx")?;
+    }
+    if has_my {
+        write!(w, ",My")?;
+    }
+    if has_mx {
+        write!(w, ",Mx_sim")?;
+    }
+    if has_my {
+        write!(w, ",My_sim")?;
+    }
+    writeln!(w)?;
+    for (s, f) in rec.samples.iter().zip(&rp.sim) {
+        write!(
+            w,
+            "{},{},{},{},{},{},{}",
+            s.time, s.fx, s.fy, s.mz, f.fx, f.fy, f.mz
+        )?;
+        if has_mx {
+            write!(w, ",{}", s.mx)?;
+        }
+        if has_my {
+            write!(w, ",{}", s.my)?;
+        }
+        if has_mx {
+            write!(w, ",{}", f.mx)?;
+        }
+        if has_my {
+            write!(w, ",{}", f.my)?;
+        }
+        writeln!(w)?;
+    }
+    w.flush()
+}

@@ -16,7 +16,7 @@
 //! interest as dual numbers and solve with the same conditioned inputs:
 //!
 //! ```
-//! use num_dual::{Dual64, DualNum};
+//! use tyrekit::mf::num_dual::{Dual64, DualNum};
 //! use tyrekit::mf::{MfInput, Model, Tyre, UseMode};
 //! let tyre = Tyre::builtin();
 //! let k = tyrekit::tir::keys::key_index("PDY1").unwrap();
@@ -57,6 +57,10 @@ pub mod real;
 pub use equations::{Form, Model, Solution};
 pub use limits::{Clamped, Conditions};
 pub use real::Real;
+
+/// The dual-number crate the equations are instantiated with, re-exported so
+/// users seed derivatives with exactly the types [`Real`] is implemented for.
+pub use num_dual;
 
 use crate::tir::{MfVersion, TyreParams};
 

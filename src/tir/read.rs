@@ -116,7 +116,9 @@ pub fn read(text: &str, file: &str) -> Result<ReadOut> {
                     // empty values are only warned about.
                     if let Some(s) = other.as_str() {
                         let t = s.trim();
-                        if t.starts_with(|c: char| c.is_ascii_digit() || matches!(c, '+' | '-' | '.')) {
+                        if t.starts_with(|c: char| {
+                            c.is_ascii_digit() || matches!(c, '+' | '-' | '.')
+                        }) {
                             return Err(Error::Tir {
                                 file: file.to_string(),
                                 line: e.line,

@@ -39,6 +39,21 @@ pub trait Fitted {
 pub trait Candidate {
     fn name(&self) -> &'static str;
     fn n_params(&self) -> usize;
+    /// The physics in one line, as a tyre engineer would say it
+    /// ("transient slip lag"): used in the explanation of a verdict.
+    fn physics(&self) -> &'static str {
+        self.name()
+    }
+    /// The fitted extension in words with its key parameter(s), e.g.
+    /// "a relaxation length of 0.31 m (×1.2 the file's)".
+    fn describe(&self, fitted: &dyn Fitted) -> String {
+        fitted
+            .parameters()
+            .iter()
+            .map(|(k, v)| format!("{k} = {v:.4}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
     /// Fit on the samples where `mask` is true (the rest is never looked at).
     fn fit(
         &self,
@@ -217,6 +232,12 @@ impl Candidate for RelaxationCandidate {
             params,
         }))
     }
+}
+
+/// Every candidate the diagnosis weighs, `none` first. The one registry:
+/// the report, the CLI and the proof tests all take their list from here.
+pub fn all() -> Vec<Box<dyn Candidate>> {
+    vec![Box::new(NoneCandidate), Box::new(RelaxationCandidate)]
 }
 
 /// A candidate's evaluation.

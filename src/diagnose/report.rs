@@ -7,7 +7,7 @@
 //!
 //! Must never: name an effect whose held-out improvement is within noise.
 
-use super::candidate::{evaluate, Candidate, NoneCandidate, RelaxationCandidate, CHANNELS};
+use super::candidate::{all, evaluate, Candidate, CHANNELS};
 use super::locate::{frictional_energy, locate, Finding, LocateOptions, Residuals};
 use super::replay::{replay, ReplayOptions};
 use crate::data::Recording;
@@ -88,7 +88,8 @@ pub fn diagnose(rec: &Recording, tyre: &Tyre, opts: &ReplayOptions) -> Result<Di
         let f = locate_channel(rec, &base.sim, &energy, ch);
         loc.insert(ch.into(), serde_json::to_value(&f).unwrap_or(Value::Null));
     }
-    let cands: [&dyn Candidate; 2] = [&NoneCandidate, &RelaxationCandidate];
+    let owned = all();
+    let cands: Vec<&dyn Candidate> = owned.iter().map(|c| c.as_ref()).collect();
     let ev = evaluate(rec, tyre, opts, &cands)?;
     let before = nrmse_map(rec, &base.sim);
     let best = ev
@@ -124,7 +125,7 @@ pub fn diagnose(rec: &Recording, tyre: &Tyre, opts: &ReplayOptions) -> Result<Di
         "verdict": verdict,
         "effects": effects,
         "locate": loc,
-        "candidates_implemented": ["none", "relaxation"],
+        "candidates_implemented": owned.iter().map(|c| c.name()).collect::<Vec<_>>(),
         "samples": rec.samples.len(),
         "segments": rec.segments.len(),
     });

@@ -140,14 +140,9 @@ fn turn_slip_lags_with_lateral_relaxation_length() {
 /// Well-formed files (MF 6.1 example, Pacejka book defaults) are never refused.
 #[test]
 fn real_tir_files_never_crash() {
-    // The shared data sit beside the crate root; TYREKIT_SHARED overrides
-    // that (for a worktree that is not beside them).
-    let dir = match std::env::var("TYREKIT_SHARED") {
-        Ok(d) => format!("{d}/data/tir"),
-        Err(_) => concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data/tir").to_string(),
-    };
+    let dir = shared().join("data/tir");
     let Ok(entries) = std::fs::read_dir(&dir) else {
-        println!("SKIP: {dir} not found (shared data absent)");
+        println!("SKIP: {} not found (shared data absent)", dir.display());
         return;
     };
     let mut files: Vec<_> = entries

@@ -455,7 +455,7 @@ pub(crate) fn step(c: &StepCtx, p: &LuGreParams, st: &mut TransientState, dt: f6
         mx: o.mx,
         my: o.my,
         mz,
-        kappa: c.kin.kappa,
+        kappa: c.dir * c.kin.kappa,
         alpha: c.kin.alpha,
         re: c.props.re,
         mux: c.s * c.props.mux,

@@ -568,25 +568,28 @@ pub(crate) struct StepCtx<'a> {
     pub omega_re: f64,
     /// Whether the force evaluation runs at a raised speed (|Vx| < VXLOW).
     pub floored: bool,
-    /// Rolling direction (−1 reversing from velocities, else +1): see [`StepCtx::forces`].
+    /// −1 reversing from velocities, else +1: maps the transient models'
+    /// κ = −Vsx/|Vx| to the MF's κ = −Vsx/Vx (see [`StepCtx::forces`]).
     pub dir: f64,
 }
 
 impl StepCtx<'_> {
     /// The transient models' force evaluation at slips `sl` (κ = −Vsx/|Vx|):
-    /// the forward-rolling MF, mirrored when reversing — κ_MF = dir·κ and
-    /// Fx = dir·Fx_MF — so that braking while reversing uses the braking
-    /// branch of the curve (the MF's brake/drive asymmetry, SHx, SVx), as a
-    /// tyre turned around would, and as MFeval does with κ of the sign of Vx.
+    /// the MF at the signed (floored) speed with the MF's own slip convention
+    /// κ_MF = −Vsx/Vx = dir·κ, exactly as the steady model evaluates it — so
+    /// that braking while reversing uses the braking branch of the curve (the
+    /// MF's brake/drive asymmetry, SHx, SVx) with Fx mirrored by the MF
+    /// (Pacejka 3rd ed. eq. 4.E9 with MFeval's sign of Vx), and the backward
+    /// conventions of Fy (α* modes), My and Mz are the MF's own: a settled
+    /// transient model equals the steady one in reverse too
+    /// (tests/transient_reverse.rs).
     #[inline]
     pub fn forces(&self, base: &MfInput, sl: Slip) -> Forces {
         let sl = Slip {
             kappa: self.dir * sl.kappa,
             ..sl
         };
-        let mut o = mf_at(self.tyre, base, self.mode, sl, self.s);
-        o.fx *= self.dir;
-        o
+        mf_at(self.tyre, base, self.mode, sl, self.s)
     }
 
     /// Low-speed offset correction (N): the MF's force at zero slip at the
@@ -662,18 +665,19 @@ impl TransientModel {
         let props = tyre_props(tyre, &probe, fz, inp.vx.abs());
         let kin = kinematics(self.config.input_mode, inp, props.re);
         let steady = self.config.kind == TransientKind::Steady;
-        // The force evaluation. Transient models: forward speed ≥ VXLOW, so
-        // that the MF's steady-state low-speed slip reduction and its
-        // backward-speed sign flip stay out (the transient model handles low
-        // speed and direction itself, with κ = −Vsx/|Vx| — as MFeval's
-        // transient modes skip that reduction). Steady: the MF as it is.
+        // The force evaluation. Transient models: speed of the sign of Vx
+        // and magnitude ≥ VXLOW, so that the MF's steady-state low-speed slip
+        // reduction stays out (the transient model handles low speed itself
+        // — as MFeval's transient modes skip that reduction) while its
+        // backward-running conventions stay in. Steady: the MF as it is.
         let fbase = if steady {
             base
         } else {
             let vl = tyre.params().p.vxlow;
             let vl = if vl.is_finite() && vl > 0.0 { vl } else { 1.0 };
+            let v = inp.vx.abs().max(vl);
             MfInput {
-                vx: inp.vx.abs().max(vl),
+                vx: if inp.vx < 0.0 { -v } else { v },
                 ..base
             }
         };
@@ -736,7 +740,12 @@ impl TransientModel {
                     let (cx, cy) = ctx.offset_correction();
                     o.fx += cx;
                     o.fy += cy;
-                    self.output(&ctx, &o, sl)
+                    // Report the slip in the MF's convention (as the steady model).
+                    let used = Slip {
+                        kappa: ctx.dir * k,
+                        ..sl
+                    };
+                    self.output(&ctx, &o, used)
                 }
                 _ => lugre::step(&ctx, &self.options.lugre, &mut next, dt),
             }

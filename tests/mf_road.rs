@@ -191,6 +191,14 @@ fn slip_properties_match_evaluate_bit_for_bit() {
                     s.re, s.cx, s.cy, s.kxk, s.kya, s.sigmax, s.sigmay, s.mux, s.muy,
                 ];
                 assert_eq!(bits(&want), bits(&got), "{x:?} {mode:?} mu {mu}");
+                // The zero-slip forces and My as numbers (a zero may carry
+                // another sign: Gyκ·Fy0 + SVyκ adds a signed zero), γ as used.
+                assert_eq!(
+                    [o.fx, o.fy, o.my],
+                    [s.fx, s.fy, s.my],
+                    "{x:?} {mode:?} mu {mu}"
+                );
+                assert_eq!(o.gamma.to_bits(), s.gamma.to_bits());
             }
             let a = t.slip_properties(&x, mode);
             let b = t.slip_properties_mu(&x, mode, 1.0);

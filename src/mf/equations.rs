@@ -519,7 +519,7 @@ impl<T: Real> Model<T> {
     }
 
     /// The pure-slip part shared by [`Model::solve_mu`] and
-    /// [`Model::slip_props`]: normalised load and pressure (4.E2a, 4.E2b),
+    /// [`Model::zero_slip`]: normalised load and pressure (4.E2a, 4.E2b),
     /// turn-slip spin and ζ1 (4.105, 4.106), Fx0 (4.E9) and Fy0 (4.E19).
     #[inline(always)]
     fn pure(&self, c: &Conditions, mu_scale: f64, fl: &mut u32) -> Pure<T> {
@@ -554,13 +554,17 @@ impl<T: Real> Model<T> {
         }
     }
 
-    /// The slip-independent by-products of [`Model::solve_mu`] — (μx, μy,
-    /// Kxκ, Kyα) — bit-identical to its `mux`, `muy`, `kxk`, `kya` for the
-    /// same conditions, without the combined-slip and moment equations.
-    pub fn slip_props(&self, c: &Conditions, mu_scale: f64) -> (T, T, T, T) {
+    /// The zero-slip evaluation the transient models probe every step:
+    /// (μx, μy, Kxκ, Kyα, Fx, Fy, My) for conditions with κ = α = 0, equal
+    /// (as numbers; a zero may differ in sign) to [`Model::solve_mu`]'s —
+    /// at zero slip the combined-slip weights are exactly 1 and the
+    /// κ-induced side force SVyκ is 0 (Pacejka 3rd ed. 4.E51, 4.E59, 4.E66),
+    /// so Fx = Fx0, Fy = Fy0 — without the weights and the Mx, Mz equations.
+    pub fn zero_slip(&self, c: &Conditions, mu_scale: f64) -> [T; 7] {
         let mut fl = 0u32;
         let r = self.pure(c, mu_scale, &mut fl);
-        (r.mux, r.f.muy, r.kxk, r.f.kya)
+        let my = self.my(c, r.fx0);
+        [r.mux, r.f.muy, r.kxk, r.f.kya, r.fx0, r.f.fy0, my]
     }
 
     /// Forces and moments for combined slip (and the by-products).

@@ -234,6 +234,12 @@ pub struct SlipProps {
     pub sigmay: f64,
     pub mux: f64,
     pub muy: f64,
+    /// Forces and rolling resistance moment at zero slip (N, N·m).
+    pub fx: f64,
+    pub fy: f64,
+    pub my: f64,
+    /// Inclination angle as used (after the limit checks) (rad).
+    pub gamma: f64,
 }
 
 /// A tyre ready to evaluate: the property file plus whatever can be
@@ -432,7 +438,7 @@ impl Tyre {
     }
 
     /// The zero-slip properties the transient models need each step,
-    /// without the combined-slip and moment equations: the values
+    /// without the combined-slip weights and the Mx, Mz equations: the values
     /// [`Tyre::evaluate_mu`] gives for the same input with κ = α = 0
     /// (bit-identical; the other inputs as given, ω estimated the same way).
     pub fn slip_properties_mu(&self, inp: &MfInput, mode: UseMode, mu_scale: f64) -> SlipProps {
@@ -442,7 +448,7 @@ impl Tyre {
             ..*inp
         };
         let (c, _, [re, _, _]) = self.conditions_radius(&zero, mode);
-        let (mux, muy, kxk, kya) = self.model.slip_props(&c, mu_scale);
+        let [mux, muy, kxk, kya, fx, fy, my] = self.model.zero_slip(&c, mu_scale);
         let is52 = self.model.form != Form::Mf6;
         let (cx, cy, sigmax, sigmay) = extras::relaxation(&self.params.p, is52, &c, kxk, kya);
         SlipProps {
@@ -455,6 +461,10 @@ impl Tyre {
             sigmay,
             mux,
             muy: if mode.limits { muy.abs() } else { muy },
+            fx,
+            fy,
+            my,
+            gamma: c.gamma_u,
         }
     }
 

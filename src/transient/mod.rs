@@ -26,17 +26,17 @@
 //! 0–300 km/h and standstill sliding.
 //!
 //! # Magic Formula calls (per step)
-//! 1. A full [`Tyre::evaluate`] at zero slip and the actual speed (the
-//!    "probe"): Re, μx, μy, Cx, Cy, Kxκ, Kyα, σκ, σα (slip-independent), and
-//!    My (rolling resistance with the MF's own low-speed/direction handling).
+//! 1. [`Tyre::slip_properties`] at zero slip and the actual speed (the
+//!    "probe", the pure-slip equations only): Re, μx, μy, Cx, Cy, Kxκ, Kyα,
+//!    σκ, σα (slip-independent), Fx, Fy at zero slip, and My (rolling
+//!    resistance with the MF's own low-speed/direction handling).
 //! 2. [`Tyre::forces`] at the slips the model uses. For the transient models
-//!    the MF sees a forward speed max(|Vx|, VXLOW) and κ = −Vsx/|Vx|: they
-//!    do low speed and direction themselves (MFeval's steady low-speed slip
-//!    reduction would remove the standstill hold); reversing (from
-//!    velocities) they mirror it, κ_MF = −κ, Fx = −Fx_MF (`StepCtx::forces`),
-//!    so braking backwards uses the braking branch of an asymmetric curve.
-//!    `Steady` calls the MF as is (κ with the sign of Vx, as MFeval expects
-//!    for reversing).
+//!    the MF sees the speed sgn(Vx)·max(|Vx|, VXLOW) — they do low speed
+//!    themselves (MFeval's steady low-speed slip reduction would remove the
+//!    standstill hold) — and the MF's own slip convention κ_MF = −Vsx/Vx
+//!    (`StepCtx::forces`), so that braking backwards uses the braking branch
+//!    of an asymmetric curve and a settled transient tyre equals the steady
+//!    one in reverse. `Steady` calls the MF as is.
 //! 3. Below VXLOW only: the forces at zero slip at the raised speed, so that
 //!    the MF's force at zero slip (shifts, camber thrust) keeps the MF's own
 //!    low-speed reduction (`StepCtx::offset_correction`).
@@ -60,7 +60,7 @@ pub mod scenario;
 
 pub use lugre::{LuGreFriction, LuGreParams};
 
-use crate::mf::{Forces, MfInput, MfOutput, Tyre, UseMode};
+use crate::mf::{Forces, MfInput, SlipProps, Tyre, UseMode};
 use crate::tir::MfVersion;
 
 /// Which dynamics sit between the wheel's motion and the Magic Formula.
@@ -358,7 +358,7 @@ pub fn low_speed_weight(vx_abs: f64, vxlow: f64) -> f64 {
     }
 }
 
-/// Tyre properties for this step from the probe evaluation `o` (see [`TyreProps`]).
+/// Tyre properties for this step from the zero-slip probe `o` ([`Tyre::slip_properties`]; see [`TyreProps`]).
 ///
 /// * Carcass stiffnesses: the MF's Cx, Cy (MF 6.1/6.2 load and pressure
 ///   dependent, PCFX*/PCFY*); when the MF gives none, LONGITUDINAL_STIFFNESS /
@@ -372,7 +372,7 @@ pub fn low_speed_weight(vx_abs: f64, vxlow: f64) -> f64 {
 /// * Low-speed damping (N s/m): `DAMP_VLOW·C + 2·DAMP_LONG·√(C·BELT_MASS)`
 ///   (the low-speed damping proportional to stiffness plus the carcass' own
 ///   relative damping on the belt mass), blended in below VXLOW.
-pub fn tyre_props(tyre: &Tyre, o: &MfOutput, fz: f64, vx_abs: f64) -> TyreProps {
+pub fn tyre_props(tyre: &Tyre, o: &SlipProps, fz: f64, vx_abs: f64) -> TyreProps {
     let p = &tyre.params().p;
     let pos = |x: f64, fb: f64| if x.is_finite() && x > 0.0 { x } else { fb };
     let cx = pos(o.cx, pos(p.longitudinal_stiffness, 3e5));
@@ -642,8 +642,8 @@ impl TransientModel {
     /// Advance by `dt` seconds with inputs held constant over the step and
     /// return the outputs at the end of the step. On error the state is unchanged.
     ///
-    /// Cost: one full Magic Formula evaluation (a zero-slip probe for Re, μ,
-    /// the stiffnesses and relaxation lengths) and one forces-only one; below
+    /// Cost: one zero-slip probe (pure-slip equations, for Re, μ, the
+    /// stiffnesses and relaxation lengths) and one forces-only evaluation; below
     /// VXLOW one more forces-only one (zero-slip offsets); the non-linear
     /// relaxation variant adds three per slope evaluation (one per step when
     /// the slips change little, two per sub-step otherwise).
@@ -661,7 +661,7 @@ impl TransientModel {
             p: inp.p,
             omega: inp.omega,
         };
-        let probe = tyre.evaluate(&base, mode);
+        let probe = tyre.slip_properties(&base, mode);
         let props = tyre_props(tyre, &probe, fz, inp.vx.abs());
         let kin = kinematics(self.config.input_mode, inp, props.re);
         let steady = self.config.kind == TransientKind::Steady;

@@ -10,6 +10,7 @@
 //! Must never: allocate, or silently drop a NaN input (NaN passes through to
 //! the outputs).
 
+use super::fastmath;
 use super::{MfInput, UseMode};
 use crate::tir::MfParams;
 
@@ -182,15 +183,15 @@ impl Conditions {
         };
         let mut fz_mz = fz;
         let mut smooth = 1.0;
-        let tan_alpha_in = alpha.tan();
+        let tan_alpha_in = fastmath::tan(alpha);
         if mode.limits {
             if phit != 0.0 {
-                phit *= alpha.cos();
+                phit *= fastmath::cos(alpha);
             }
             let vxlow = p.vxlow;
             if vx.abs() <= vxlow {
                 fl |= Clamped::LOW_SPEED;
-                let w = 0.5 * (1.0 + (std::f64::consts::PI * (vx / vxlow)).cos());
+                let w = 0.5 * (1.0 + fastmath::cos(std::f64::consts::PI * (vx / vxlow)));
                 smooth = 1.0 - w;
                 let lin = (vx / vxlow).abs();
                 kappa_low *= lin;
@@ -256,10 +257,10 @@ impl Conditions {
         let tan_alpha = if alpha == inp.alpha {
             tan_alpha_in
         } else {
-            alpha.tan()
+            fastmath::tan(alpha)
         };
         let (alpha_star, gamma_star) = if mode.alpha_star {
-            (tan_alpha * crate::mf::real::sign(vx), gamma.sin())
+            (tan_alpha * crate::mf::real::sign(vx), fastmath::sin(gamma))
         } else {
             (alpha, gamma)
         };

@@ -51,6 +51,7 @@
 
 pub mod equations;
 pub mod extras;
+pub mod fastmath;
 pub mod limits;
 pub mod real;
 

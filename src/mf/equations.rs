@@ -181,14 +181,14 @@ impl<T: Real> Model<T> {
     fn spin(&self, c: &Conditions, dfz: T) -> Spin<T> {
         let p = &self.p;
         let eps_g = p.pecp1 * (dfz * p.pecp2 + 1.0);
-        let vsy = -c.alpha.ftan() * c.vx.abs();
+        let vsy = -c.alpha.tan() * c.vx.abs();
         let mut vc = (c.vx * c.vx + vsy * vsy).sqrt();
         if c.vx.abs() < p.vxlow.v() {
             let s = if c.vx < 0.0 { -1.0 } else { 1.0 };
             vc = p.vxlow.v() * s;
         }
         let psi_dot = -c.phit * vc;
-        let phi = (-(-eps_g + 1.0) * (c.omega * c.gamma.fsin()) + psi_dot) * (1.0 / vc);
+        let phi = (-(-eps_g + 1.0) * (c.omega * c.gamma.sin()) + psi_dot) * (1.0 / vc);
         Spin { phi, eps_g }
     }
 
@@ -218,7 +218,7 @@ impl<T: Real> Model<T> {
         let load = if self.skip_pkx3 {
             fz * (p.pkx1 + p.pkx2 * dfz)
         } else {
-            fz * (p.pkx1 + p.pkx2 * dfz) * (p.pkx3 * dfz).fexp()
+            fz * (p.pkx1 + p.pkx2 * dfz) * (p.pkx3 * dfz).exp()
         };
         let kxk = load * (p.ppx1 * dpi + p.ppx2 * dpi * dpi + 1.0) * p.lkx; // 4.E15
         let bx = kxk / (cx * dx + EPS * sign1(dx)); // 4.E16
@@ -232,7 +232,7 @@ impl<T: Real> Model<T> {
             *fl |= Clamped::EX;
         }
         let bk = bx * kx;
-        let mut fx0 = dx * (cx * curved(bk, ex).fatan()).fsin() + svx; // 4.E9
+        let mut fx0 = dx * (cx * curved(bk, ex).atan()).sin() + svx; // 4.E9
         if c.vx < 0.0 {
             fx0 = -fx0;
         }
@@ -248,7 +248,7 @@ impl<T: Real> Model<T> {
         if self.pky4_is_2 {
             arg * 2.0 / (arg * arg + 1.0)
         } else {
-            (p.pky4 * arg.fatan()).fsin()
+            (p.pky4 * arg.atan()).sin()
         }
     }
 
@@ -292,7 +292,7 @@ impl<T: Real> Model<T> {
         let (zeta2, zeta3) = match spin {
             Some(s) => {
                 let z3 = cos_atan(p.pkyp1 * r0 * r0 * s.phi * s.phi); // 4.79
-                let byp = p.pdyp1 * (p.pdyp2 * dfz + 1.0) * cos_atan(p.pdyp3 * c.alpha.ftan()); // 4.78
+                let byp = p.pdyp1 * (p.pdyp2 * dfz + 1.0) * cos_atan(p.pdyp3 * c.alpha.tan()); // 4.78
                 let rphi = r0 * abs(s.phi);
                 let z2 = cos_atan(byp * (rphi + p.pdyp4 * rphi.sqrt())); // 4.77
                 (z2, z3)
@@ -305,7 +305,7 @@ impl<T: Real> Model<T> {
         let kyg0 = if self.is52() {
             // MF-Tyre 5.2: camber stiffness from PHY3 and PVY3/4.
             let kya0 =
-                p.pky1 * self.fz0p * (p.pky4 * (fz / (p.pky2 * self.fz0p)).fatan()).fsin() * p.lkyc;
+                p.pky1 * self.fz0p * (p.pky4 * (fz / (p.pky2 * self.fz0p)).atan()).sin() * p.lkyc;
             (p.phy3 * kya0 + fz * (p.pvy3 + p.pvy4 * dfz)) * p.lkyc
         } else {
             fz * (p.pky6 + p.pky7 * dfz) * (p.ppy5 * dpi + 1.0) * p.lkyc // 4.E30
@@ -324,7 +324,7 @@ impl<T: Real> Model<T> {
                 let kyrp0 = kyg0 / (-s.eps_g + 1.0); // 4.89
                 let bhyp = kyrp0 / (chyp * dhyp * kya0_p); // 4.88
                 let x = bhyp * r0 * s.phi;
-                let shyp = dhyp * (chyp * curved(x, ehyp).fatan()).fsin() * sign(c.vx); // 4.80
+                let shyp = dhyp * (chyp * curved(x, ehyp).atan()).sin() * sign(c.vx); // 4.80
                 (T::c(0.0), shyp + 1.0 - svyg / kya_p) // 4.83, 4.84
             }
             None => (one, one),
@@ -356,7 +356,7 @@ impl<T: Real> Model<T> {
         }
         let by = kya / (cy * dy + EPS * sign1(dy)); // 4.E26
         let ba = by * ay;
-        let mut fy0 = dy * (cy * curved(ba, ey).fatan()).fsin() + svy; // 4.E19
+        let mut fy0 = dy * (cy * curved(ba, ey).atan()).sin() + svy; // 4.E19
         if c.mode.alpha_star && c.vx < 0.0 {
             fy0 = -fy0;
         }
@@ -386,7 +386,7 @@ impl<T: Real> Model<T> {
         let svyk = if !T::TRACKS_DERIVATIVES && dvyk.v() == 0.0 {
             T::c(0.0) // value-only: no κ-induced side force
         } else {
-            dvyk * (p.rvy5 * (p.rvy6 * c.kappa).fatan()).fsin() * p.lvyka * c.smooth
+            dvyk * (p.rvy5 * (p.rvy6 * c.kappa).atan()).sin() * p.lvyka * c.smooth
             // 4.E66
         };
         let shyk = p.rhy1 + p.rhy2 * dfz; // 4.E65
@@ -447,13 +447,13 @@ impl<T: Real> Model<T> {
             T::c(0.0)
         } else {
             p.qsx4
-                * (p.qsx5 * (q6 * q6).fatan()).fcos()
-                * (p.qsx7 * g + p.qsx8 * (p.qsx9 * fyn).fatan()).fsin()
+                * (p.qsx5 * (q6 * q6).atan()).cos()
+                * (p.qsx7 * g + p.qsx8 * (p.qsx9 * fyn).atan()).sin()
         };
         let atan_term = if self.skip_mx_atan {
             T::c(0.0)
         } else {
-            p.qsx10 * (p.qsx11 * fzn).fatan() * g
+            p.qsx10 * (p.qsx11 * fzn).atan() * g
         };
         r0 * fz
             * p.lmx
@@ -507,7 +507,7 @@ impl<T: Real> Model<T> {
         if k >= low && k <= high {
             // Linear ramp from 0 at κ = −1 to π/2 at κ = `high`.
             let red = (0.0 * (high - k) + PI / 2.0 * (k + 1.0)) / (high + 1.0);
-            my *= red.fsin();
+            my *= red.sin();
         }
         if k < low {
             my = -my;
@@ -622,7 +622,7 @@ impl<T: Real> Model<T> {
         let et_shape = if !T::TRACKS_DERIVATIVES && qez45.v() == 0.0 {
             T::c(1.0) // value-only: the atan term is multiplied by 0
         } else {
-            qez45 * (2.0 / PI) * (bt * ct * alphat).fatan() + 1.0
+            qez45 * (2.0 / PI) * (bt * ct * alphat).atan() + 1.0
         };
         let et = (p.qez1 + p.qez2 * dfz + p.qez3 * dfz * dfz) * et_shape; // 4.E44
         let (et, hit) = cap_one(et, c.mode.limits);
@@ -645,7 +645,7 @@ impl<T: Real> Model<T> {
                     mzp_inf = T::c(1e-6);
                 }
                 let cdrp = p.qdrp1; // 4.96
-                let ddrp = mzp_inf / (cdrp * (0.5 * PI)).fsin(); // 4.94
+                let ddrp = mzp_inf / (cdrp * (0.5 * PI)).sin(); // 4.94
 
                 // As in MFeval: QDZ8·QDZ9·dfz (product) and |γ| unscaled (4.99).
                 let kzgr0 = fzm
@@ -653,8 +653,8 @@ impl<T: Real> Model<T> {
                     * (p.qdz8 * p.qdz9 * dfz + (p.qdz10 + p.qdz11 * dfz * c.gamma.abs()))
                     * p.lkzc;
                 let bdrp = kzgr0 / (cdrp * ddrp * (-s.eps_g + 1.0));
-                let drp = ddrp * (cdrp * (bdrp * r0 * c.phit).fatan()).fsin();
-                let mzp90 = mzp_inf * (2.0 / PI) * (p.qcrp2 * r0 * c.phit.abs()).fatan() * gyk; // 4.103
+                let drp = ddrp * (cdrp * (bdrp * r0 * c.phit).atan()).sin();
+                let mzp90 = mzp_inf * (2.0 / PI) * (p.qcrp2 * r0 * c.phit.abs()).atan() * gyk; // 4.103
 
                 // At φt = 0 both are 0; use the limit φt → 0 of the ratio
                 // (MFeval gives 0/0 = NaN there: a deliberate difference).
@@ -686,7 +686,7 @@ impl<T: Real> Model<T> {
                     * zeta0)
             * lmuy
             * sign(c.vx)
-            * c.alpha_star.fcos()
+            * c.alpha_star.cos()
             + zeta8
             - 1.0; // 4.E47
         let br = (p.qbz9 * p.lky * inv_lmuy + p.qbz10 * f.by * f.cy) * zeta6; // 4.E45
@@ -695,8 +695,8 @@ impl<T: Real> Model<T> {
         // Combined-slip aligning torque (4.E71–4.E78 with paper A54–A56).
         let kr = kxk / kya_p;
         let kk2 = kr * kr * (c.kappa * c.kappa);
-        let ar_eq = (alphar.ftan() * alphar.ftan() + kk2).sqrt().fatan() * sign(alphar); // A54
-        let at_eq = (alphat.ftan() * alphat.ftan() + kk2).sqrt().fatan() * sign(alphat); // A55
+        let ar_eq = (alphar.tan() * alphar.tan() + kk2).sqrt().atan() * sign(alphar); // A54
+        let at_eq = (alphat.tan() * alphat.tan() + kk2).sqrt().atan() * sign(alphat); // A55
         let s =
             r0 * (p.ssz1 + p.ssz2 * (fy * self.inv_fnomin) + (p.ssz3 + p.ssz4 * dfz) * g_z) * p.ls; // A56
 
@@ -704,7 +704,7 @@ impl<T: Real> Model<T> {
         let mzr = if spin.is_none() {
             dr * cos_atan(br * ar_eq)
         } else {
-            dr * (cr * (br * ar_eq).fatan()).fcos()
+            dr * (cr * (br * ar_eq).atan()).cos()
         } * c.smooth; // 4.E75
                       // Fy at γ = 0 (and Gyκ with the original γ*, as MFeval does to match TNO).
         let f0 = if c.gamma_star == 0.0 {
@@ -720,7 +720,7 @@ impl<T: Real> Model<T> {
         let fy_prime = gyk * f0.fy0; // 4.E74
         let bat = bt * at_eq;
         // 4.E73, multiplied by LFZO as TNO's solver does (found by MFeval).
-        let t = dt * (ct * curved(bat, et).fatan()).fcos() * c.cos_alpha_prime * p.lfzo * c.smooth;
+        let t = dt * (ct * curved(bat, et).atan()).cos() * c.cos_alpha_prime * p.lfzo * c.smooth;
         let mz = if self.is52() {
             -t * (fy - svyk0) + mzr + s * fx // MF-Tyre 5.2 manual
         } else {
@@ -755,7 +755,7 @@ fn weight<T: Real>(unit_c: bool, c: T, b: T, e: T) -> T {
     if unit_c {
         cos_atan(y)
     } else {
-        (c * y.fatan()).fcos()
+        (c * y.atan()).cos()
     }
 }
 
@@ -767,6 +767,6 @@ fn curved<T: Real>(bx: T, e: T) -> T {
     if !T::TRACKS_DERIVATIVES && e.v() == 0.0 {
         bx
     } else {
-        bx - e * (bx - bx.fatan())
+        bx - e * (bx - bx.atan())
     }
 }

@@ -11,7 +11,6 @@
 //! Must never: allocate, loop without a bound, or turn an undefined value
 //! (0/0, negative root) into a finite number that looks valid.
 
-use super::fastmath;
 use super::limits::Conditions;
 use crate::tir::MfParams;
 
@@ -27,7 +26,7 @@ pub fn effective_radius(p: &MfParams<f64>, c: &Conditions, omega_in: f64) -> (f6
     let r0 = p.unloaded_radius;
     let cz = p.vertical_stiffness * (1.0 + p.pfz1 * dpi);
     let fzn = c.fz_u / p.fnomin;
-    let defl = (p.fnomin / cz) * (p.dreff * fastmath::atan(p.breff * fzn) + p.freff * fzn);
+    let defl = (p.fnomin / cz) * (p.dreff * (p.breff * fzn).atan() + p.freff * fzn);
     let romega_of = |w: f64| r0 * (p.q_re0 + p.q_v1 * ((w * r0) / p.longvl).powi(2));
     if omega_in != 0.0 {
         // ε added as MFeval does (keeps Rω defined at ω = 0).
@@ -247,10 +246,9 @@ pub fn relaxation(
         p.lateral_stiffness * (1.0 + p.pcfy1 * dfz + p.pcfy2 * dfz * dfz) * (1.0 + p.pcfy3 * dpi);
     let (sx, sy) = if is52 {
         let r0 = p.unloaded_radius;
-        let sx =
-            (p.ptx1 + p.ptx2 * dfz) * fastmath::exp(-p.ptx3 * dfz) * p.lsgkp * r0 * c.fz / p.fnomin;
+        let sx = (p.ptx1 + p.ptx2 * dfz) * (-p.ptx3 * dfz).exp() * p.lsgkp * r0 * c.fz / p.fnomin;
         let sy = p.pty1
-            * fastmath::sin(2.0 * fastmath::atan(c.fz / (p.pty2 * fz0p)))
+            * (2.0 * (c.fz / (p.pty2 * fz0p)).atan()).sin()
             * (1.0 - p.pky3 * c.gamma.abs())
             * r0
             * p.lfzo

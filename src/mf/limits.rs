@@ -10,7 +10,6 @@
 //! Must never: allocate, or silently drop a NaN input (NaN passes through to
 //! the outputs).
 
-use super::fastmath;
 use super::{MfInput, UseMode};
 use crate::tir::MfParams;
 
@@ -183,15 +182,15 @@ impl Conditions {
         };
         let mut fz_mz = fz;
         let mut smooth = 1.0;
-        let tan_alpha_in = fastmath::tan(alpha);
+        let tan_alpha_in = alpha.tan();
         if mode.limits {
             if phit != 0.0 {
-                phit *= fastmath::cos(alpha);
+                phit *= alpha.cos();
             }
             let vxlow = p.vxlow;
             if vx.abs() <= vxlow {
                 fl |= Clamped::LOW_SPEED;
-                let w = 0.5 * (1.0 + fastmath::cos(std::f64::consts::PI * (vx / vxlow)));
+                let w = 0.5 * (1.0 + (std::f64::consts::PI * (vx / vxlow)).cos());
                 smooth = 1.0 - w;
                 let lin = (vx / vxlow).abs();
                 kappa_low *= lin;
@@ -257,10 +256,10 @@ impl Conditions {
         let tan_alpha = if alpha == inp.alpha {
             tan_alpha_in
         } else {
-            fastmath::tan(alpha)
+            alpha.tan()
         };
         let (alpha_star, gamma_star) = if mode.alpha_star {
-            (tan_alpha * crate::mf::real::sign(vx), fastmath::sin(gamma))
+            (tan_alpha * crate::mf::real::sign(vx), gamma.sin())
         } else {
             (alpha, gamma)
         };

@@ -51,7 +51,6 @@
 
 pub mod equations;
 pub mod extras;
-pub mod fastmath;
 pub mod limits;
 pub mod real;
 

@@ -6,17 +6,9 @@
 //! gives the fitter exact derivatives with respect to any parameter seeded in
 //! [`crate::tir::MfParams::map`].
 //!
-//! Elementary functions go through the `f*` methods of [`Real`] (`fatan`,
-//! `fsin`, `fcos`, `ftan`, `fexp`, `fpowd`): for `f64` they are the inlined
-//! implementations of [`super::fastmath`] (within 2 ulp of std, 4 for pow —
-//! asserted there), for dual numbers `num-dual`'s own functions, so
-//! derivatives are exact and value parts agree with `f64` to a few ulp.
-//!
-//! Must never: branch on anything but the real part, or compute an `f64`
-//! value differently from the dual numbers' value part except through those
-//! few-ulp elementary functions.
+//! Must never: branch on anything but the real part, or change the value of
+//! the `f64` instantiation (for `f64` every helper is the plain operation).
 
-use super::fastmath;
 pub use num_dual::DualNum;
 
 /// A scalar the Magic Formula can be evaluated with: `f64` or a `Copy`
@@ -38,64 +30,10 @@ pub trait Real: DualNum<f64> + Copy + Send + Sync {
     fn c(x: f64) -> Self {
         Self::from(x)
     }
-    /// Arc tangent (`f64`: [`fastmath::atan`]).
-    #[inline(always)]
-    fn fatan(self) -> Self {
-        self.atan()
-    }
-    /// Sine (`f64`: [`fastmath::sin`]).
-    #[inline(always)]
-    fn fsin(self) -> Self {
-        self.sin()
-    }
-    /// Cosine (`f64`: [`fastmath::cos`]).
-    #[inline(always)]
-    fn fcos(self) -> Self {
-        self.cos()
-    }
-    /// Tangent (`f64`: [`fastmath::tan`]).
-    #[inline(always)]
-    fn ftan(self) -> Self {
-        self.tan()
-    }
-    /// Exponential (`f64`: [`fastmath::exp`]).
-    #[inline(always)]
-    fn fexp(self) -> Self {
-        self.exp()
-    }
-    /// Power `self^y` (`f64`: [`fastmath::pow`]).
-    #[inline(always)]
-    fn fpowd(self, y: Self) -> Self {
-        self.powd(y)
-    }
 }
 
 impl Real for f64 {
     const TRACKS_DERIVATIVES: bool = false;
-    #[inline(always)]
-    fn fatan(self) -> f64 {
-        fastmath::atan(self)
-    }
-    #[inline(always)]
-    fn fsin(self) -> f64 {
-        fastmath::sin(self)
-    }
-    #[inline(always)]
-    fn fcos(self) -> f64 {
-        fastmath::cos(self)
-    }
-    #[inline(always)]
-    fn ftan(self) -> f64 {
-        fastmath::tan(self)
-    }
-    #[inline(always)]
-    fn fexp(self) -> f64 {
-        fastmath::exp(self)
-    }
-    #[inline(always)]
-    fn fpowd(self, y: f64) -> f64 {
-        fastmath::pow(self, y)
-    }
 }
 
 impl<const N: usize> Real for num_dual::DualSVec64<N> {
@@ -149,7 +87,7 @@ pub fn pow<T: Real>(x: T, y: T) -> T {
     if T::TRACKS_DERIVATIVES && x.v() == 0.0 {
         T::c(0f64.powf(y.v()))
     } else {
-        x.fpowd(y)
+        x.powd(y)
     }
 }
 
@@ -186,7 +124,5 @@ mod tests {
             0.0
         );
         assert!((cos_atan(0.7) - 0.7f64.atan().cos()).abs() < 1e-16);
-        // 0^y through fastmath::pow is std's powf.
-        assert_eq!(pow(0.0, 0.85), 0.0);
     }
 }

@@ -67,7 +67,6 @@
 //! Must never: allocate in `step`, divide by a speed or a force without a guard.
 
 use super::{relax_exact, Slip, StepCtx, TransientState, WheelOutput, SLOT_X, SLOT_Y};
-use crate::mf::fastmath;
 
 /// Which friction function the bristles saturate at.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -315,9 +314,9 @@ impl LuGreParams {
 fn stribeck_shape(v: f64, p: &LuGreParams) -> f64 {
     let r = v / p.vs;
     if p.delta == 1.0 {
-        fastmath::exp(-r)
+        (-r).exp()
     } else {
-        fastmath::exp(-fastmath::pow(r, p.delta))
+        (-r.powf(p.delta)).exp()
     }
 }
 
@@ -341,7 +340,7 @@ fn elastoplastic(z: f64, zss: f64, vr: f64, beta: f64) -> f64 {
         0.0
     } else {
         let x = (r - 0.5 * (1.0 + beta)) / (1.0 - beta);
-        0.5 + 0.5 * fastmath::sin(std::f64::consts::PI * x)
+        0.5 + 0.5 * (std::f64::consts::PI * x).sin()
     }
 }
 

@@ -60,7 +60,6 @@ pub mod scenario;
 
 pub use lugre::{LuGreFriction, LuGreParams};
 
-use crate::mf::fastmath;
 use crate::mf::{Forces, MfInput, SlipProps, Tyre, UseMode};
 use crate::tir::MfVersion;
 
@@ -263,11 +262,11 @@ pub fn kinematics(mode: InputMode, inp: &WheelInput, re: f64) -> Kinematics {
                 kappa: -vsx / v,
                 tan_alpha: vsy / v,
                 v_roll: (inp.vx - vsx).abs(),
-                alpha: fastmath::atan(vsy / v),
+                alpha: (vsy / v).atan(),
             }
         }
         InputMode::Slips => {
-            let tan_alpha = fastmath::tan(inp.alpha_in);
+            let tan_alpha = inp.alpha_in.tan();
             Kinematics {
                 vx_abs,
                 vsx: -inp.kappa_in * vx_abs,
@@ -293,7 +292,7 @@ pub fn relax_exact(x: f64, r: f64, d: f64, h: f64) -> f64 {
             1.0 - z * (0.5 - z * (1.0 / 6.0 - z * (1.0 / 24.0 - z / 120.0))),
         )
     } else {
-        let e = fastmath::exp(-z);
+        let e = (-z).exp();
         (e, (1.0 - e) / z)
     };
     x * e + d * h * p1
@@ -355,7 +354,7 @@ pub fn low_speed_weight(vx_abs: f64, vxlow: f64) -> f64 {
     if vx_abs >= vl {
         0.0
     } else {
-        0.5 * (1.0 + fastmath::cos(std::f64::consts::PI * vx_abs / vl))
+        0.5 * (1.0 + (std::f64::consts::PI * vx_abs / vl).cos())
     }
 }
 
@@ -386,7 +385,7 @@ pub fn tyre_props(tyre: &Tyre, o: &SlipProps, fz: f64, vx_abs: f64) -> TyreProps
         o.sigmax.clamp(SIGMA_MIN, SIGMA_MAX)
     } else if legacy && p.ptx1 != 0.0 {
         // MF 5.2: σκ = Fz·(PTX1 + PTX2·dfz)·exp(−PTX3·dfz)·(R0/Fz0)·LSGKP
-        let s = fz * (p.ptx1 + p.ptx2 * dfz) * fastmath::exp(-p.ptx3 * dfz) * (r0 / fz0) * p.lsgkp;
+        let s = fz * (p.ptx1 + p.ptx2 * dfz) * (-p.ptx3 * dfz).exp() * (r0 / fz0) * p.lsgkp;
         sigma_from(s, 1.0)
     } else {
         sigma_from(o.kxk, cx)
@@ -396,7 +395,7 @@ pub fn tyre_props(tyre: &Tyre, o: &SlipProps, fz: f64, vx_abs: f64) -> TyreProps
     } else if legacy && p.pty1 != 0.0 && p.pty2 != 0.0 {
         // MF 5.2: σα = PTY1·sin(2·atan(Fz/(PTY2·Fz0)))·(1 − PKY3·|γ|)·R0·LFZO·LSGAL
         let s = p.pty1
-            * fastmath::sin(2.0 * fastmath::atan(fz / (p.pty2 * fz0)))
+            * (2.0 * (fz / (p.pty2 * fz0)).atan()).sin()
             * (1.0 - p.pky3 * o.gamma.abs())
             * r0
             * p.lfzo
@@ -465,7 +464,7 @@ pub fn mf_at(tyre: &Tyre, base: &MfInput, mode: UseMode, slip: Slip, s: f64) -> 
         tyre.forces(&mi, mode)
     } else {
         mi.kappa = slip.kappa / s;
-        mi.alpha = fastmath::atan(slip.tan_alpha / s);
+        mi.alpha = (slip.tan_alpha / s).atan();
         let mut o = tyre.forces(&mi, mode);
         o.fx *= s;
         o.fy *= s;
@@ -490,7 +489,7 @@ impl Slip {
         Slip {
             kappa,
             tan_alpha,
-            alpha: fastmath::atan(tan_alpha),
+            alpha: tan_alpha.atan(),
         }
     }
     /// The kinematic slips of a step.

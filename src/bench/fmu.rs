@@ -1,7 +1,8 @@
 //! Benchmark section `fmu`: the cost of one co-simulation step through the C
 //! ABI as a master sees it — fmi2SetReal of the 10 inputs, fmi2DoStep,
 //! fmi2GetReal of the 14 Real outputs — on the packaged FMU loaded with dlopen,
-//! beside the direct library call (`TransientModel::step`) for the same inputs.
+//! beside the direct library call (`TransientModel::step`) for the same inputs,
+//! each the best 1000-step chunk of thread CPU time (the machine is shared).
 //! Goal (issue #3): ≤ 250 ns per step for the steady-state tyre.
 //! Must never: assert on timings (figures are printed, not tested).
 
@@ -12,7 +13,6 @@ use crate::mf::Tyre;
 use crate::tir::TyreParams;
 use crate::transient::{TransientConfig, TransientModel, WheelInput};
 use std::hint::black_box;
-use std::time::Instant;
 
 const INPUTS: [u32; 10] = [
     vr::VX,
@@ -49,35 +49,61 @@ fn inputs(k: usize) -> [f64; 10] {
     [20.0, vy, 63.8, 4000.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0]
 }
 
+/// Steps per timed chunk; each figure is the best chunk (the machine is
+/// shared: the least disturbed chunk is the one closest to the code's cost).
+const CHUNK: usize = 1000;
+
+/// Best-chunk thread CPU time per call of `f` (ns), `f` called with the
+/// step index `0..n`, after one untimed chunk.
+fn best_chunk_ns(n: usize, mut f: impl FnMut(usize) -> crate::Result<()>) -> crate::Result<f64> {
+    for k in 0..CHUNK {
+        f(k)?;
+    }
+    let mut best = f64::INFINITY;
+    for c in 1..=(n / CHUNK).max(1) {
+        let t0 = super::mf::cpu_ns();
+        for k in c * CHUNK..(c + 1) * CHUNK {
+            f(k)?;
+        }
+        best = best.min((super::mf::cpu_ns() - t0) / CHUNK as f64);
+    }
+    Ok(best)
+}
+
+/// The direct library call's inputs for step `k`.
+fn wheel(k: usize) -> WheelInput {
+    let u = inputs(k);
+    WheelInput {
+        vx: u[0],
+        vy: u[1],
+        omega: u[2],
+        fz: u[3],
+        gamma: u[4],
+        p: u[5],
+        phit: u[6],
+        mu_scale: u[7],
+        kappa_in: u[8],
+        alpha_in: u[9],
+    }
+}
+
 /// Run this section, printing its figures.
 pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
     let n: usize = if ctx.quick { 20_000 } else { 1_000_000 };
     let h = 1e-3;
-    println!("[fmu] one co-simulation step, steady-state tyre, {n} steps");
+    println!(
+        "[fmu] one co-simulation step, steady-state tyre, {n} steps, thread CPU time, best {CHUNK}-step chunk"
+    );
 
     // Direct library call.
     let tyre = Tyre::new(TyreParams::builtin())?;
     let mut model = TransientModel::new(TransientConfig::default());
-    let t0 = Instant::now();
     let mut acc = 0.0;
-    for k in 0..n {
-        let u = inputs(k);
-        let w = WheelInput {
-            vx: u[0],
-            vy: u[1],
-            omega: u[2],
-            fz: u[3],
-            gamma: u[4],
-            p: u[5],
-            phit: u[6],
-            mu_scale: u[7],
-            kappa_in: u[8],
-            alpha_in: u[9],
-        };
-        acc += model.step(&tyre, black_box(&w), h)?.fy;
-    }
+    let direct = best_chunk_ns(n, |k| {
+        acc += model.step(&tyre, black_box(&wheel(k)), h)?.fy;
+        Ok(())
+    })?;
     black_box(acc);
-    let direct = t0.elapsed().as_secs_f64() * 1e9 / n as f64;
 
     // Through the C ABI of the packaged FMU.
     let fmu_path = packaging::package(&packaging::Options {
@@ -98,16 +124,18 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
         let s = fmu.slave("bench", &cb, &[])?;
         s.exit_initialization()?;
         let mut y = [0.0; 14];
-        let t0 = Instant::now();
         let mut acc = 0.0;
-        for k in 0..n {
+        let mut step = 0usize;
+        let ns = best_chunk_ns(n, |k| {
             s.set_real(&INPUTS, black_box(&inputs(k)))?;
-            s.do_step(k as f64 * h, h)?;
+            s.do_step(step as f64 * h, h)?;
+            step += 1;
             s.get_real(&OUTPUTS, &mut y)?;
             acc += y[1];
-        }
+            Ok(())
+        })?;
         black_box(acc);
-        Ok(t0.elapsed().as_secs_f64() * 1e9 / n as f64)
+        Ok(ns)
     })();
     let _ = std::fs::remove_dir_all(&dir);
     let abi = result?;

@@ -209,7 +209,7 @@ fn time_ns(inp: &[MfInput], reps: usize, mut f: impl FnMut(&MfInput) -> f64) -> 
 
 /// CPU time of this thread (ns): the machine is shared, so wall time would
 /// mostly measure other processes. Falls back to wall time if unavailable.
-fn cpu_ns() -> f64 {
+pub(super) fn cpu_ns() -> f64 {
     let mut ts = libc::timespec {
         tv_sec: 0,
         tv_nsec: 0,

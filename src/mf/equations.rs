@@ -192,7 +192,8 @@ impl<T: Real> Model<T> {
         Spin { phi, eps_g }
     }
 
-    /// Pure longitudinal force Fx0 (4.E9–4.E18), with μx and Kxκ.
+    /// Pure longitudinal force Fx0 (4.E9–4.E18), with μx and Kxκ. With
+    /// `force = false` only μx and Kxκ are computed (Fx0 is NaN).
     #[allow(clippy::too_many_arguments)]
     fn fx0(
         &self,
@@ -202,6 +203,7 @@ impl<T: Real> Model<T> {
         zeta1: T,
         gx: T,
         lmux: T,
+        force: bool,
         fl: &mut u32,
     ) -> (T, T, T) {
         let p = &self.p;
@@ -221,6 +223,9 @@ impl<T: Real> Model<T> {
             fz * (p.pkx1 + p.pkx2 * dfz) * (p.pkx3 * dfz).exp()
         };
         let kxk = load * (p.ppx1 * dpi + p.ppx2 * dpi * dpi + 1.0) * p.lkx; // 4.E15
+        if !force {
+            return (T::c(f64::NAN), mux, kxk);
+        }
         let bx = kxk / (cx * dx + EPS * sign1(dx)); // 4.E16
         let shx = (p.phx1 + p.phx2 * dfz) * p.lhx * c.smooth; // 4.E17
         let svx = fz * (p.pvx1 + p.pvx2 * dfz) * p.lvx * lmux * zeta1 * c.smooth; // 4.E18
@@ -272,7 +277,9 @@ impl<T: Real> Model<T> {
     }
 
     /// Pure lateral force Fy0 (4.E19–4.E30) at camber `gs` (γ*, scaled by LGAY
-    /// for PAC2002), with turn slip ζ2, ζ3, ζ4 when `spin` is given.
+    /// for PAC2002), with turn slip ζ2, ζ3, ζ4 when `spin` is given. With
+    /// `force = false` the final 4.E19 (Fy0 itself) is skipped (NaN); μy, Kyα
+    /// and the shifts are computed all the same.
     #[allow(clippy::too_many_arguments)]
     fn fy0(
         &self,
@@ -283,6 +290,7 @@ impl<T: Real> Model<T> {
         spin: Option<Spin<T>>,
         lmuy: T,
         shape: Option<T>,
+        force: bool,
         fl: &mut u32,
     ) -> Fy0<T> {
         let p = &self.p;
@@ -355,8 +363,11 @@ impl<T: Real> Model<T> {
             *fl |= Clamped::EY;
         }
         let by = kya / (cy * dy + EPS * sign1(dy)); // 4.E26
-        let ba = by * ay;
-        let mut fy0 = dy * (cy * curved(ba, ey).atan()).sin() + svy; // 4.E19
+        let mut fy0 = if force {
+            dy * (cy * curved(by * ay, ey).atan()).sin() + svy // 4.E19
+        } else {
+            T::c(f64::NAN)
+        };
         if c.mode.alpha_star && c.vx < 0.0 {
             fy0 = -fy0;
         }
@@ -520,9 +531,10 @@ impl<T: Real> Model<T> {
 
     /// The pure-slip part shared by [`Model::solve_mu`] and
     /// [`Model::zero_slip`]: normalised load and pressure (4.E2a, 4.E2b),
-    /// turn-slip spin and ζ1 (4.105, 4.106), Fx0 (4.E9) and Fy0 (4.E19).
+    /// turn-slip spin and ζ1 (4.105, 4.106), Fx0 (4.E9) and Fy0 (4.E19) —
+    /// the forces themselves only when `fx`/`fy` ask for them (NaN otherwise).
     #[inline(always)]
-    fn pure(&self, c: &Conditions, mu_scale: f64, fl: &mut u32) -> Pure<T> {
+    fn pure(&self, c: &Conditions, mu_scale: f64, fx: bool, fy: bool, fl: &mut u32) -> Pure<T> {
         let p = &self.p;
         let fz = T::c(c.fz);
         let dfz = (fz - self.fz0p) * self.inv_fz0p; // 4.E2a
@@ -541,8 +553,8 @@ impl<T: Real> Model<T> {
             }
             None => T::c(1.0),
         };
-        let (fx0, mux, kxk) = self.fx0(c, dfz, dpi, zeta1, gx, p.lmux * mu_scale, fl);
-        let f = self.fy0(c, dfz, dpi, gs_y, spin, p.lmuy * mu_scale, None, fl);
+        let (fx0, mux, kxk) = self.fx0(c, dfz, dpi, zeta1, gx, p.lmux * mu_scale, fx, fl);
+        let f = self.fy0(c, dfz, dpi, gs_y, spin, p.lmuy * mu_scale, None, fy, fl);
         Pure {
             dfz,
             dpi,
@@ -561,10 +573,49 @@ impl<T: Real> Model<T> {
     /// κ-induced side force SVyκ is 0 (Pacejka 3rd ed. 4.E51, 4.E59, 4.E66),
     /// so Fx = Fx0, Fy = Fy0 — without the weights and the Mx, Mz equations.
     pub fn zero_slip(&self, c: &Conditions, mu_scale: f64) -> [T; 7] {
+        self.zero_slip_parts(c, mu_scale, true, true)
+    }
+
+    /// [`Model::zero_slip`] computing only what is asked for: μx, μy, Kxκ,
+    /// Kyα always; Fx, Fy at zero slip only with `forces`, My only with `my`
+    /// (the others are NaN). What is computed has the same bits as in
+    /// [`Model::zero_slip`] (the same operations on the same operands); the
+    /// skipped parts are the Magic Formula's sin(C·atan(…)) of 4.E9/4.E19 and
+    /// the rolling-resistance powers — most of the probe's cost.
+    pub fn zero_slip_parts(&self, c: &Conditions, mu_scale: f64, forces: bool, my: bool) -> [T; 7] {
         let mut fl = 0u32;
-        let r = self.pure(c, mu_scale, &mut fl);
-        let my = self.my(c, r.fx0);
+        // My needs Fx (its QSY2 term).
+        let r = self.pure(c, mu_scale, forces || my, forces, &mut fl);
+        let my = if my {
+            self.my(c, r.fx0)
+        } else {
+            T::c(f64::NAN)
+        };
         [r.mux, r.f.muy, r.kxk, r.f.kya, r.fx0, r.f.fy0, my]
+    }
+
+    /// Combined-slip Fx, Fy (4.E50, 4.E58) from the pure-slip part, with the
+    /// weight Gyκ and the unit κ-induced side force the aligning torque reuses.
+    #[inline(always)]
+    fn combined(&self, c: &Conditions, r: &Pure<T>, fl: &mut u32) -> (T, T, T, T) {
+        let gs = T::c(c.gamma_star);
+        let (gyk, svyk_unit) = self.gyk(c, r.dfz, gs * self.lgay, fl);
+        let gxa = self.gxa(c, r.dfz, gs * self.lgax, fl);
+        let fx = gxa * r.fx0; // 4.E50
+        let fy = gyk * r.f.fy0 + svyk_unit * r.f.muy * r.f.zeta2; // 4.E58
+        (fx, fy, gyk, svyk_unit)
+    }
+
+    /// Combined-slip Fx and Fy only, without the moments (for callers that
+    /// need no more: finite-difference slopes, the transient models'
+    /// zero-slip offsets and LuGre's cross terms): the same operations as
+    /// [`Model::solve_mu`]'s Fx, Fy, so the same bits, at well under its cost
+    /// (no Mz ingredients, no second Fy0 at γ = 0, no Mx, My).
+    pub fn solve_fxfy(&self, c: &Conditions, mu_scale: f64) -> (T, T) {
+        let mut fl = 0u32;
+        let r = self.pure(c, mu_scale, true, true, &mut fl);
+        let (fx, fy, _, _) = self.combined(c, &r, &mut fl);
+        (fx, fy)
     }
 
     /// Forces and moments for combined slip (and the by-products).
@@ -587,12 +638,11 @@ impl<T: Real> Model<T> {
         let inv_lmuy = self.inv_lmuy * (1.0 / mu_scale);
         let mut fl = 0u32;
         let one = T::c(1.0);
-        let r = self.pure(c, mu_scale, &mut fl);
-        let (dfz, dpi, spin, fx0, mux, kxk, f) = (r.dfz, r.dpi, r.spin, r.fx0, r.mux, r.kxk, r.f);
+        let r = self.pure(c, mu_scale, true, true, &mut fl);
+        let (dfz, dpi, spin, mux, kxk, f) = (r.dfz, r.dpi, r.spin, r.mux, r.kxk, r.f);
         let gs = T::c(c.gamma_star);
         let g = T::c(c.gamma);
-        let (gs_y, gs_z, g_z) = (gs * self.lgay, gs * self.lgaz, g * self.lgaz);
-        let gs_x = gs * self.lgax;
+        let (gs_z, g_z) = (gs * self.lgaz, g * self.lgaz);
         let r0 = p.unloaded_radius;
 
         // Aligning-torque ingredients (4.E31–4.E47, Dt and Bt per paper A60, A58).
@@ -630,11 +680,7 @@ impl<T: Real> Model<T> {
             fl |= Clamped::ET;
         }
 
-        let (gyk, svyk_unit) = self.gyk(c, dfz, gs_y, &mut fl);
-        let (fx, fy) = {
-            let gxa = self.gxa(c, dfz, gs_x, &mut fl);
-            (gxa * fx0, gyk * f.fy0 + svyk_unit * f.muy * f.zeta2) // 4.E50, 4.E58
-        };
+        let (fx, fy, gyk, svyk_unit) = self.combined(c, &r, &mut fl);
 
         let (zeta0, zeta6, zeta7, zeta8) = match spin {
             Some(s) => {
@@ -714,7 +760,7 @@ impl<T: Real> Model<T> {
             // With PKY5 = 0 the load shape of Kyα does not depend on γ
             // (value-only: the same operands give the same bits).
             let shape = if self.skip_pky5 { Some(f.shape) } else { None };
-            self.fy0(c, dfz, dpi, T::c(0.0), spin, lmuy, shape, &mut fl)
+            self.fy0(c, dfz, dpi, T::c(0.0), spin, lmuy, shape, true, &mut fl)
         };
         let svyk0 = svyk_unit * f0.muy;
         let fy_prime = gyk * f0.fy0; // 4.E74

@@ -437,18 +437,44 @@ impl Tyre {
         }
     }
 
+    /// Fx and Fy of [`Tyre::forces_mu`] only (bit-identical to its `fx`,
+    /// `fy`), without the moment equations ([`Model::solve_fxfy`]).
+    /// Allocation-free.
+    #[inline]
+    pub fn forces_xy_mu(&self, inp: &MfInput, mode: UseMode, mu_scale: f64) -> (f64, f64) {
+        let (c, _) = self.conditions(inp, mode);
+        self.model.solve_fxfy(&c, mu_scale)
+    }
+
     /// The zero-slip properties the transient models need each step,
     /// without the combined-slip weights and the Mx, Mz equations: the values
     /// [`Tyre::evaluate_mu`] gives for the same input with κ = α = 0
     /// (bit-identical; the other inputs as given, ω estimated the same way).
     pub fn slip_properties_mu(&self, inp: &MfInput, mode: UseMode, mu_scale: f64) -> SlipProps {
+        self.slip_properties_parts(inp, mode, mu_scale, true, true)
+    }
+
+    /// [`Tyre::slip_properties_mu`] computing Fx, Fy (at zero slip) only with
+    /// `forces` and My only with `my` (NaN otherwise); every other field, and
+    /// those asked for, bit-identical to [`Tyre::slip_properties_mu`]. The
+    /// transient step asks only for what its model uses (see
+    /// `transient::TransientModel::step`): the skipped force equations are
+    /// most of the probe's cost.
+    pub fn slip_properties_parts(
+        &self,
+        inp: &MfInput,
+        mode: UseMode,
+        mu_scale: f64,
+        forces: bool,
+        my: bool,
+    ) -> SlipProps {
         let zero = MfInput {
             kappa: 0.0,
             alpha: 0.0,
             ..*inp
         };
         let (c, _, [re, _, _]) = self.conditions_radius(&zero, mode);
-        let [mux, muy, kxk, kya, fx, fy, my] = self.model.zero_slip(&c, mu_scale);
+        let [mux, muy, kxk, kya, fx, fy, my] = self.model.zero_slip_parts(&c, mu_scale, forces, my);
         let is52 = self.model.form != Form::Mf6;
         let (cx, cy, sigmax, sigmay) = extras::relaxation(&self.params.p, is52, &c, kxk, kya);
         SlipProps {

@@ -376,12 +376,12 @@ pub(crate) fn step(c: &StepCtx, p: &LuGreParams, st: &mut TransientState, dt: f6
             let fx_a = if k.tan_alpha == 0.0 {
                 zx
             } else {
-                c.forces(&c.base, Slip::new(0.0, k.tan_alpha)).fx
+                c.forces_xy(&c.base, Slip::new(0.0, k.tan_alpha)).0
             };
             let fy_k = if k.kappa == 0.0 {
                 zy
             } else {
-                c.forces(&c.base, Slip::new(k.kappa, 0.0)).fy
+                c.forces_xy(&c.base, Slip::new(k.kappa, 0.0)).1
             };
             let keep = 1.0 - c.props.weight;
             let (b0x, b0y) = (zx + keep * (fx_a - zx), zy + keep * (fy_k - zy));

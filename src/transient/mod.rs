@@ -26,10 +26,11 @@
 //! 0–300 km/h and standstill sliding.
 //!
 //! # Magic Formula calls (per step)
-//! 1. [`Tyre::slip_properties`] at zero slip and the actual speed (the
+//! 1. [`Tyre::slip_properties_parts`] at zero slip and the actual speed (the
 //!    "probe", the pure-slip equations only): Re, μx, μy, Cx, Cy, Kxκ, Kyα,
-//!    σκ, σα (slip-independent), Fx, Fy at zero slip, and My (rolling
-//!    resistance with the MF's own low-speed/direction handling).
+//!    σκ, σα (slip-independent); Fx, Fy at zero slip only where they are used
+//!    (below VXLOW, LuGre), and My (rolling resistance with the MF's own
+//!    low-speed/direction handling) only for the transient models.
 //! 2. [`Tyre::forces`] at the slips the model uses. For the transient models
 //!    the MF sees the speed sgn(Vx)·max(|Vx|, VXLOW) — they do low speed
 //!    themselves (MFeval's steady low-speed slip reduction would remove the
@@ -326,7 +327,8 @@ pub struct TyreProps {
     /// Friction coefficients (MF's μx, μy; slip-independent), before the friction scale.
     pub mux: f64,
     pub muy: f64,
-    /// MF forces at zero slip (N), at the actual speed (0 if not finite).
+    /// MF forces at zero slip (N), at the actual speed (0 if not finite, or
+    /// not computed: the step's probe skips them where they are not used).
     pub fx0: f64,
     pub fy0: f64,
     /// Slip stiffnesses at zero slip, Kxκ (N) and Kyα (N/rad), from the MF.
@@ -457,21 +459,41 @@ pub fn tyre_props(tyre: &Tyre, o: &SlipProps, fz: f64, vx_abs: f64) -> TyreProps
 /// make this exact — see the transient report.
 #[inline]
 pub fn mf_at(tyre: &Tyre, base: &MfInput, mode: UseMode, slip: Slip, s: f64) -> Forces {
-    let mut mi = *base;
-    if s == 1.0 {
-        mi.kappa = slip.kappa;
-        mi.alpha = slip.alpha;
-        tyre.forces(&mi, mode)
-    } else {
-        mi.kappa = slip.kappa / s;
-        mi.alpha = (slip.tan_alpha / s).atan();
-        let mut o = tyre.forces(&mi, mode);
+    let mut o = tyre.forces(&similar_input(base, slip, s), mode);
+    if s != 1.0 {
         o.fx *= s;
         o.fy *= s;
         o.mx *= s;
         o.mz *= s;
-        o
     }
+    o
+}
+
+/// Fx, Fy of [`mf_at`] only (bit-identical to its), without the moment
+/// equations ([`Tyre::forces_xy_mu`]).
+#[inline]
+pub fn mf_at_xy(tyre: &Tyre, base: &MfInput, mode: UseMode, slip: Slip, s: f64) -> (f64, f64) {
+    let (fx, fy) = tyre.forces_xy_mu(&similar_input(base, slip, s), mode, 1.0);
+    if s != 1.0 {
+        (fx * s, fy * s)
+    } else {
+        (fx, fy)
+    }
+}
+
+/// The MF input of [`mf_at`]: the slips divided by the friction scale `s`
+/// (the similarity method), as given for `s = 1`.
+#[inline]
+fn similar_input(base: &MfInput, slip: Slip, s: f64) -> MfInput {
+    let mut mi = *base;
+    if s == 1.0 {
+        mi.kappa = slip.kappa;
+        mi.alpha = slip.alpha;
+    } else {
+        mi.kappa = slip.kappa / s;
+        mi.alpha = (slip.tan_alpha / s).atan();
+    }
+    mi
 }
 
 /// A slip point: κ, tan α and α (kept together so α = atan(tan α) is computed once).
@@ -592,6 +614,16 @@ impl StepCtx<'_> {
         mf_at(self.tyre, base, self.mode, sl, self.s)
     }
 
+    /// Fx, Fy of [`StepCtx::forces`] only (bit-identical), without the moments.
+    #[inline]
+    pub fn forces_xy(&self, base: &MfInput, sl: Slip) -> (f64, f64) {
+        let sl = Slip {
+            kappa: self.dir * sl.kappa,
+            ..sl
+        };
+        mf_at_xy(self.tyre, base, self.mode, sl, self.s)
+    }
+
     /// Low-speed offset correction (N): the MF's force at zero slip at the
     /// actual speed (the probe, with the MF's own low-speed reduction of its
     /// shifts) minus that at the raised speed of the force evaluation. Zero
@@ -602,7 +634,7 @@ impl StepCtx<'_> {
         if !self.floored {
             return (0.0, 0.0);
         }
-        let f = self.forces(&self.base, Slip::default());
+        let (fx, fy) = self.forces_xy(&self.base, Slip::default());
         let d = |p: f64, f: f64| {
             let x = self.s * p - f;
             if x.is_finite() {
@@ -611,7 +643,7 @@ impl StepCtx<'_> {
                 0.0
             }
         };
-        (d(self.props.fx0, f.fx), d(self.props.fy0, f.fy))
+        (d(self.props.fx0, fx), d(self.props.fy0, fy))
     }
 }
 
@@ -661,9 +693,6 @@ impl TransientModel {
             p: inp.p,
             omega: inp.omega,
         };
-        let probe = tyre.slip_properties(&base, mode);
-        let props = tyre_props(tyre, &probe, fz, inp.vx.abs());
-        let kin = kinematics(self.config.input_mode, inp, props.re);
         let steady = self.config.kind == TransientKind::Steady;
         // The force evaluation. Transient models: speed of the sign of Vx
         // and magnitude ≥ VXLOW, so that the MF's steady-state low-speed slip
@@ -681,6 +710,15 @@ impl TransientModel {
                 ..base
             }
         };
+        // The probe computes only what this step uses: Fx, Fy at zero slip for
+        // the low-speed offset correction and LuGre's direct force, My for the
+        // transient models' rolling resistance (the steady model takes the
+        // force evaluation's). The rest of `SlipProps` is always computed.
+        let floored = fbase.vx != base.vx;
+        let want_forces = floored || self.config.kind == TransientKind::LuGre;
+        let probe = tyre.slip_properties_parts(&base, mode, 1.0, want_forces, !steady);
+        let props = tyre_props(tyre, &probe, fz, inp.vx.abs());
+        let kin = kinematics(self.config.input_mode, inp, props.re);
         let ctx = StepCtx {
             tyre,
             mode,
@@ -690,7 +728,7 @@ impl TransientModel {
             s,
             fz,
             omega_re: inp.omega * props.re,
-            floored: fbase.vx != base.vx,
+            floored,
             dir: if self.config.input_mode == InputMode::Velocities && inp.vx < 0.0 {
                 -1.0
             } else {
@@ -864,10 +902,7 @@ fn relax_linear(c: &StepCtx, st: &mut TransientState, dt: f64) -> (f64, f64) {
 fn inst_sigma(c: &StepCtx, k: f64, t: f64) -> (f64, f64) {
     const H: f64 = 1e-5;
     let mut mi = c.base;
-    let f = |mi: &mut MfInput, kk: f64, tt: f64| {
-        let o = c.forces(mi, Slip::new(kk, tt));
-        (o.fx, o.fy)
-    };
+    let f = |mi: &mut MfInput, kk: f64, tt: f64| c.forces_xy(mi, Slip::new(kk, tt));
     let f0 = f(&mut mi, k, t);
     let fk = f(&mut mi, k + H, t);
     let ft = f(&mut mi, k, t + H);

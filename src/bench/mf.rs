@@ -247,6 +247,15 @@ pub fn run(ctx: &BenchContext) -> crate::Result<()> {
     let ns_props = time_ns(&inp, reps, |x| tyre.slip_properties(x, mode).kya);
     println!("[mf] Tyre::forces_mu (road friction scale 0.6):      {ns_mu:8.1} ns/eval");
     println!("[mf] Tyre::slip_properties (zero-slip Re, C, K, σ, μ): {ns_props:8.1} ns/eval");
+    let ns_xy = time_ns(&inp, reps, |x| {
+        let (fx, fy) = tyre.forces_xy_mu(x, mode, 1.0);
+        fx + fy
+    });
+    let ns_parts = time_ns(&inp, reps, |x| {
+        tyre.slip_properties_parts(x, mode, 1.0, false, false).kya
+    });
+    println!("[mf] Tyre::forces_xy_mu (Fx Fy only, no moments):     {ns_xy:8.1} ns/eval");
+    println!("[mf] Tyre::slip_properties_parts (no Fx Fy My; the steady step's probe): {ns_parts:8.1} ns/eval");
     // A fully populated MF 6.1 file (every curvature factor and shift non-zero,
     // so none of the zero-coefficient shortcuts applies), when the shared data
     // is there; the Python peers then run on it.

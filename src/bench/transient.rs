@@ -1,9 +1,11 @@
 //! Benchmark section `transient`: nanoseconds per `TransientModel::step` (one
 //! FMU communication step's tyre work) for each transient model, beside one
 //! full Magic Formula evaluation measured in the same run (each step costs a
-//! full evaluation plus one forces evaluation; below VXLOW one more; LuGre up
-//! to two more for the combined-slip cross terms), at 20 m/s and at 0.5 m/s
-//! (below VXLOW: offset correction, LuGre sub-steps). Goal: ≤ 300 ns/step.
+//! zero-slip probe of the pure-slip equations plus one forces evaluation;
+//! below VXLOW one Fx/Fy-only evaluation more; LuGre two more for the
+//! combined-slip cross terms; the non-linear relaxation three per slope), at
+//! 20 m/s and at 0.5 m/s (below VXLOW: offset correction, LuGre sub-steps).
+//! Goal: ≤ 300 ns/step.
 //!
 //! Must never: assert on timings (figures are reported, not checked).
 

@@ -760,7 +760,9 @@ impl<T: Real> Model<T> {
             // With PKY5 = 0 the load shape of Kyα does not depend on γ
             // (value-only: the same operands give the same bits).
             let shape = if self.skip_pky5 { Some(f.shape) } else { None };
-            self.fy0(c, dfz, dpi, T::c(0.0), spin, lmuy, shape, true, &mut fl)
+            // The MF-Tyre 5.2 Mz takes only μy at γ = 0 from it, not Fy0.
+            let force = !self.is52();
+            self.fy0(c, dfz, dpi, T::c(0.0), spin, lmuy, shape, force, &mut fl)
         };
         let svyk0 = svyk_unit * f0.muy;
         let fy_prime = gyk * f0.fy0; // 4.E74

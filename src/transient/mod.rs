@@ -38,7 +38,8 @@
 //!    (`StepCtx::forces`), so that braking backwards uses the braking branch
 //!    of an asymmetric curve and a settled transient tyre equals the steady
 //!    one in reverse. `Steady` calls the MF as is.
-//! 3. Below VXLOW only: the forces at zero slip at the raised speed, so that
+//! 3. Below VXLOW only: Fx, Fy at zero slip at the raised speed (the moment-free
+//!    [`Tyre::forces_xy_mu`], as LuGre's cross terms and the non-linear slopes), so that
 //!    the MF's force at zero slip (shifts, camber thrust) keeps the MF's own
 //!    low-speed reduction (`StepCtx::offset_correction`).
 //!
@@ -675,10 +676,12 @@ impl TransientModel {
     /// return the outputs at the end of the step. On error the state is unchanged.
     ///
     /// Cost: one zero-slip probe (pure-slip equations, for Re, μ, the
-    /// stiffnesses and relaxation lengths) and one forces-only evaluation; below
-    /// VXLOW one more forces-only one (zero-slip offsets); the non-linear
-    /// relaxation variant adds three per slope evaluation (one per step when
-    /// the slips change little, two per sub-step otherwise).
+    /// stiffnesses and relaxation lengths; the zero-slip forces and My only
+    /// where used) and one forces-only evaluation; below VXLOW one Fx/Fy-only
+    /// one more (zero-slip offsets); LuGre two Fx/Fy-only ones (cross terms);
+    /// the non-linear relaxation variant three Fx/Fy-only ones per slope
+    /// evaluation (one per step when the slips change little, two per
+    /// sub-step otherwise).
     pub fn step(&mut self, tyre: &Tyre, inp: &WheelInput, dt: f64) -> crate::Result<WheelOutput> {
         let s = validate(self.config.input_mode, inp, dt)?;
         let fz = inp.fz.max(0.0);

@@ -11,9 +11,9 @@
 //! Must never: assert on timings.
 
 use crate::fit::mf_stages::{
-    conditions_of, stage_params, Channel, MfStage, StageData, StageKind, FIT_MODE,
+    conditions_of, fit_stage, stage_params, Channel, MfStage, StageData, StageKind, FIT_MODE,
 };
-use crate::fit::{fit, FitOptions, Problem};
+use crate::fit::Problem;
 use crate::mf::{form_of, MfInput, Tyre};
 use crate::tir::TyreParams;
 use rand::{Rng, SeedableRng};
@@ -212,18 +212,28 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
     let dir = std::env::temp_dir().join(format!("tyrekit_bench_fit_{}", std::process::id()));
     std::fs::create_dir_all(&dir).map_err(|e| crate::Error::io(&dir, e))?;
     write_inputs(&dir, &data, &start, &truth_p, &params)?;
-    let opts = FitOptions::default();
+    // The options `tyrekit fit` uses (coarse subsample first, then all samples).
+    let opts = crate::fit::mf_fit::MfFitOptions::default().fit;
     let repeats = if ctx.quick { 1 } else { 3 };
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let mut ours = f64::INFINITY;
     let mut out = None;
     for threads in if cores > 1 { vec![1, cores] } else { vec![1] } {
-        let problem = MfStage::new(form, &start.p, params.clone(), &sd, 0, Channel::Fy)?
-            .with_threads(threads);
+        let problem = MfStage::new(form, &start.p, params.clone(), &sd, 0, Channel::Fy)?;
         let mut best = f64::INFINITY;
         for _ in 0..repeats {
             let t0 = Instant::now();
-            let o = fit(&problem, None, None, &opts, "pure Fy", None)?;
+            let o = fit_stage(
+                form,
+                &start.p,
+                &params,
+                &sd,
+                &[Channel::Fy],
+                threads,
+                &opts,
+                "pure Fy",
+                None,
+            )?;
             best = best.min(t0.elapsed().as_secs_f64());
             out = Some(o);
         }

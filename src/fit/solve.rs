@@ -240,7 +240,13 @@ pub fn fit_global(
     // A candidate whose polish fails (e.g. the model is undefined there) is
     // skipped; the fit fails only if every candidate does.
     let mut first_err = None;
+    // After a coarse solution the polish starts close to the optimum: small
+    // initial damping (Madsen, Nielsen & Tingleff 2004, §3.2: τ = 1e-6 for a
+    // start believed to be good), so it takes Gauss–Newton steps at once.
+    let mut near = opts.clone();
+    near.lm.lambda0 = near.lm.lambda0.min(1e-6);
     for (which, mut cand) in starts.into_iter().enumerate() {
+        let mut polish_opts = None;
         if opts.coarse_first && !std::ptr::addr_eq(swarm_problem, problem) {
             let mut loose = opts.clone();
             loose.lm.ftol = loose.lm.ftol.max(1e-6);
@@ -260,6 +266,7 @@ pub fn fit_global(
                 &mut cws,
             ) {
                 cand = c.theta;
+                polish_opts = Some(&near);
             }
         }
         let p = match polish(
@@ -268,7 +275,7 @@ pub fn fit_global(
             (which, n_starts),
             &theta0,
             &free_in,
-            opts,
+            polish_opts.unwrap_or(opts),
             stage,
             progress.as_deref_mut(),
             &mut ws,

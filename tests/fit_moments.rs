@@ -28,7 +28,7 @@ fn worst(
     let (mut err, mut peak) = (0.0f64, 0.0f64);
     for seg in rec.segments.iter().filter(|s| s.kind == kind) {
         for s in &rec.samples[seg.start..seg.end] {
-            if !(s.fz > 0.0) {
+            if s.fz.is_nan() || s.fz <= 0.0 {
                 continue;
             }
             let (a, b) = (

@@ -165,3 +165,31 @@ fn a_steady_truth_shows_no_lag() {
         assert_eq!(fitted.get(&f.key), start.get(&f.key));
     }
 }
+
+#[test]
+fn the_staged_fit_runs_the_transient_stage_when_asked() {
+    let (truth, start) = truth_and_start();
+    let tt = Tyre::new(truth.clone()).unwrap();
+    let mut model = ProjectRelaxation {
+        steady: SteadyMf::new(tt.clone()),
+        model: TransientModel::new(TransientConfig {
+            kind: TransientKind::Relaxation,
+            input_mode: InputMode::Slips,
+            use_mode: UseMode::default(),
+        }),
+    };
+    let rec = recording(&truth, &mut model);
+    let opts = tyrekit::fit::mf_fit::MfFitOptions {
+        only: vec![],
+        transient: true,
+        nominal_from_data: false,
+        ..Default::default()
+    };
+    let res = tyrekit::fit::mf_fit::fit_mf(&[rec], start, &opts, None).unwrap();
+    assert_eq!(res.report.relaxation.len(), 2);
+    assert!(res.report.relaxation.iter().all(|f| f.identified));
+    let text = res.report.to_text();
+    assert!(text.contains("Stage transient") && text.contains("LATERAL_STIFFNESS"));
+    let lat = &res.report.relaxation[0];
+    assert_eq!(res.tyre.get("LATERAL_STIFFNESS"), Some(lat.value));
+}

@@ -1,14 +1,21 @@
 //! mf_stages — the Magic Formula as fitting problems: one [`MfStage`] per
 //! channel and group of `.tir` parameters (pure Fy, pure Fx, Mz, combined
-//! slip), with exact Jacobians by forward-mode automatic differentiation
-//! (the free parameters are seeded as `num-dual` dual numbers, eight at a
-//! time, and the crate's own [`crate::mf::Model::solve`] is evaluated over them).
+//! slip, Mx, My), with exact Jacobians by forward-mode automatic
+//! differentiation: the stage's free parameters are seeded as `num-dual`
+//! dual numbers, sixteen at a time (per lane the cheapest width of
+//! `DualSVec64` for these equations: 8 lanes ≈ 0.6 µs, 16 ≈ 0.9 µs, 32 ≈
+//! 6 µs per pure-Fy sample on the project machine), and only the fitted
+//! channel is evaluated ([`super::channels`], the same operations as
+//! [`crate::mf::Model::solve`]).
 //!
 //! Stage contents follow the usual industrial order (Pacejka, *Tyre and
 //! Vehicle Dynamics*, 3rd ed., §4.3.2 and Table 4.2): pure slip Fx
 //! (eqs. 4.E9–4.E18), pure slip Fy (4.E19–4.E30), aligning moment
-//! (4.E31–4.E49), then the combined-slip weighting functions (4.E50–4.E67).
-//! Scaling factors (λ) are never fitted.
+//! (4.E31–4.E49), then the combined-slip weighting functions (4.E50–4.E67),
+//! then the overturning and rolling-resistance moments where the data carry
+//! them (Mx: Besselink's MF 6.1 draft eq. 49; My: paper eq. A48).
+//! Scaling factors (λ) are never fitted. A large stage first converges on a
+//! subsample ([`fit_stage`], [`COARSE_SAMPLES`]).
 //!
 //! Must never: fit a scaling factor, move a camber (pressure) term when the
 //! fitted data hold one inclination (pressure) only — those are held and

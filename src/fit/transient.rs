@@ -295,7 +295,8 @@ fn fit_direction(
     // (the steady model's own replay path differs — range limits, speed
     // handling — so it is reported but not compared against).
     let gain = 1.0 - cost / costs[0];
-    let note = if !(gain >= MIN_GAIN) {
+    // (A NaN gain — a non-finite cost — is "not identified" as well.)
+    let note = if gain.is_nan() || gain < MIN_GAIN {
         format!(
             "no lag resolved: the best relaxation length lowers the cost by {:.2} % of that at σ/30 (need {:.1} %)",
             100.0 * gain,

@@ -19,6 +19,19 @@ struct ProjectRelaxation {
     model: TransientModel,
 }
 
+impl ProjectRelaxation {
+    fn new(tyre: Tyre) -> Self {
+        ProjectRelaxation {
+            steady: SteadyMf::new(tyre),
+            model: TransientModel::new(TransientConfig {
+                kind: TransientKind::Relaxation,
+                input_mode: InputMode::Slips,
+                use_mode: UseMode::default(),
+            }),
+        }
+    }
+}
+
 impl TruthModel for ProjectRelaxation {
     fn sample(&mut self, inp: &RigInput, dt: f64) -> TruthOutput {
         let mut out = self.steady.sample(inp, dt);
@@ -99,14 +112,7 @@ fn truth_and_start() -> (TyreParams, TyreParams) {
 fn relaxation_lengths_come_back_from_a_lagged_rig_recording() {
     let (truth, start) = truth_and_start();
     let tt = Tyre::new(truth.clone()).unwrap();
-    let mut model = ProjectRelaxation {
-        steady: SteadyMf::new(tt.clone()),
-        model: TransientModel::new(TransientConfig {
-            kind: TransientKind::Relaxation,
-            input_mode: InputMode::Slips,
-            use_mode: UseMode::default(),
-        }),
-    };
+    let mut model = ProjectRelaxation::new(tt.clone());
     let rec = recording(&truth, &mut model);
     let mut fitted = start.clone();
     let (fits, skipped) = fit_relaxation(&[rec], &mut fitted, None, 100).unwrap();
@@ -170,14 +176,7 @@ fn a_steady_truth_shows_no_lag() {
 fn the_staged_fit_runs_the_transient_stage_when_asked() {
     let (truth, start) = truth_and_start();
     let tt = Tyre::new(truth.clone()).unwrap();
-    let mut model = ProjectRelaxation {
-        steady: SteadyMf::new(tt.clone()),
-        model: TransientModel::new(TransientConfig {
-            kind: TransientKind::Relaxation,
-            input_mode: InputMode::Slips,
-            use_mode: UseMode::default(),
-        }),
-    };
+    let mut model = ProjectRelaxation::new(tt.clone());
     let rec = recording(&truth, &mut model);
     let opts = tyrekit::fit::mf_fit::MfFitOptions {
         only: vec![],

@@ -27,12 +27,14 @@ except ImportError as e:  # pragma: no cover
 
 
 def fy_mf61(k, alpha, fz, gamma, p):
-    """Pure-slip Fy (ISO-W), all lambdas 1, zeta 1, alpha* = alpha, gamma* = sin(gamma)."""
+    """Pure-slip Fy (ISO-W), all lambdas 1, zeta 1, no turn slip, and the use
+    mode tyrekit fits in (no range limits, so no Ey <= 1 clip; alpha* = alpha,
+    gamma* = gamma)."""
     eps = 1e-6
     fz0 = k["fnomin"]
     dfz = (fz - fz0) / fz0
     dpi = (p - k["nompres"]) / k["nompres"]
-    gs = np.sin(gamma)
+    gs = gamma
     kya = (k["pky1"] * fz0 * (1 + k["ppy1"] * dpi) * (1 - k["pky3"] * np.abs(gs))
            * np.sin(k["pky4"] * np.arctan(fz / ((k["pky2"] + k["pky5"] * gs ** 2)
                                                * (1 + k["ppy2"] * dpi) * fz0))))
@@ -47,9 +49,8 @@ def fy_mf61(k, alpha, fz, gamma, p):
     muy = ((k["pdy1"] + k["pdy2"] * dfz) * (1 + k["ppy3"] * dpi + k["ppy4"] * dpi ** 2)
            * (1 - k["pdy3"] * gs ** 2))
     dy = muy * fz
-    sgn = np.sign(ay)
+    sgn = np.where(ay < 0, -1.0, 1.0)
     ey = (k["pey1"] + k["pey2"] * dfz) * (1 + k["pey5"] * gs ** 2 - (k["pey3"] + k["pey4"] * gs) * sgn)
-    ey = np.minimum(ey, 1.0)
     by = kya / (cy * dy + eps * np.where(cy * dy >= 0, 1.0, -1.0))
     bx = by * ay
     return dy * np.sin(cy * np.arctan(bx - ey * (bx - np.arctan(bx)))) + svy

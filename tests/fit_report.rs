@@ -129,6 +129,7 @@ fn report_table_is_aligned_and_json_round_trips() {
         stages: vec![out],
         metrics: evaluate(&r, "Fy", &sim, None).unwrap(),
         holdout_metrics: vec![],
+        relaxation: vec![],
     };
     let text = rep.to_text();
     assert!(text.contains("Stage 'line'") && text.contains("sigma [%]"));

@@ -33,7 +33,9 @@ pub struct Args {
     /// Equation set: mf61, mf62, mf52, pac2002 (default: that of the start tyre).
     #[arg(long)]
     pub model: Option<String>,
-    /// Stages, comma-separated: fx, fy, mz, combined, transient (default: all).
+    /// Stages, comma-separated: fx, fy, mz, combined, mx, my, transient (default: all
+    /// but transient, each where the data carry its channel; `transient`, the relaxation lengths, replays the recordings and runs
+    /// only when named).
     #[arg(long, value_delimiter = ',')]
     pub only: Vec<String>,
     /// Hold data out of the fit: none, run[:K], condition[:K].
@@ -66,14 +68,12 @@ pub fn run(args: Args) -> Result<()> {
         let mut only = Vec::new();
         for w in &args.only {
             if w.trim().eq_ignore_ascii_case("transient") {
-                eprintln!(
-                    "tyrekit fit: the 'transient' stage (relaxation lengths) is not available yet; skipped"
-                );
+                opts.transient = true;
                 continue;
             }
             only.push(StageKind::parse(w).ok_or_else(|| {
                 Error::Input(format!(
-                    "--only '{w}': expected fx, fy, mz, combined or transient"
+                    "--only '{w}': expected fx, fy, mz, combined, mx, my or transient"
                 ))
             })?);
         }

@@ -10,12 +10,11 @@
 use super::holdout::Holdout;
 use super::metrics::{self, ChannelMetric};
 use super::mf_stages::{
-    conditions_of, gather, stage_params, Channel, MfStage, StageKind, CAMBER_SPREAD,
+    conditions_of, fit_stage, gather, stage_params, Channel, StageKind, CAMBER_SPREAD,
     PRESSURE_SPREAD,
 };
-use super::problem::{Problem, Stack};
 use super::report::FitReport;
-use super::solve::{fit, FitOptions, ProgressFn};
+use super::solve::{FitOptions, ProgressFn};
 use crate::data::Recording;
 use crate::mf::{form_of, Model};
 use crate::tir::TyreParams;
@@ -24,8 +23,12 @@ use std::ops::Range;
 /// Settings of [`fit_mf`].
 #[derive(Clone, Debug)]
 pub struct MfFitOptions {
-    /// Stages to run (in the fixed order Fx, Fy, Mz, combined).
+    /// Stages to run (in the fixed order Fx, Fy, Mz, combined, Mx, My; a
+    /// stage whose channel the data lack is skipped and reported).
     pub only: Vec<StageKind>,
+    /// Then fit the relaxation lengths ([`super::transient`]; replays, so
+    /// off by default).
+    pub transient: bool,
     pub holdout: Holdout,
     /// Take FNOMIN, NOMPRES (and INFLPRES), LONGVL from the data.
     pub nominal_from_data: bool,
@@ -43,11 +46,17 @@ impl Default for MfFitOptions {
                 StageKind::PureFy,
                 StageKind::Mz,
                 StageKind::Combined,
+                StageKind::Mx,
+                StageKind::My,
             ],
+            transient: false,
             holdout: Holdout::None,
             nominal_from_data: true,
             threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
-            fit: FitOptions::default(),
+            fit: FitOptions {
+                coarse_first: true,
+                ..Default::default()
+            },
             min_samples: 50,
         }
     }
@@ -195,6 +204,8 @@ pub fn fit_mf(
         StageKind::PureFy,
         StageKind::Mz,
         StageKind::Combined,
+        StageKind::Mx,
+        StageKind::My,
     ] {
         if !opts.only.contains(&kind) {
             continue;
@@ -228,33 +239,13 @@ pub fn fit_mf(
             data.gamma_spread < CAMBER_SPREAD,
             data.p_spread < PRESSURE_SPREAD,
         );
-        let parts: Vec<MfStage> = channels
-            .iter()
-            .enumerate()
-            .map(|(k, &c)| {
-                let ms =
-                    data.meas[k].iter().map(|y| y * y).sum::<f64>() / data.meas[k].len() as f64;
-                let w = if channels.len() > 1 && ms > 0.0 {
-                    1.0 / ms
-                } else {
-                    1.0
-                };
-                Ok(MfStage::new(form, &tyre.p, params.clone(), &data, k, c)?
-                    .with_weight(w)
-                    .with_threads(opts.threads))
-            })
-            .collect::<crate::Result<_>>()?;
-        let stack;
-        let problem: &dyn Problem = if parts.len() == 1 {
-            &parts[0]
-        } else {
-            stack = Stack::new(parts.iter().map(|p| (p as &dyn Problem, 1.0)).collect())?;
-            &stack
-        };
-        let out = fit(
-            problem,
-            None,
-            None,
+        let out = fit_stage(
+            form,
+            &tyre.p,
+            &params,
+            &data,
+            channels,
+            opts.threads,
             &opts.fit,
             kind.name(),
             progress.as_deref_mut(),
@@ -266,6 +257,12 @@ pub fn fit_mf(
         for &c in channels {
             fitted_channels.push((c, seg));
         }
+    }
+    if opts.transient {
+        let (fits, skip) =
+            super::transient::fit_relaxation(recs, &mut tyre, Some(&train), opts.min_samples)?;
+        report.relaxation = fits;
+        skipped.extend(skip);
     }
     // Quality: every fitted channel over its segments, fitted and held out.
     let model = Model::new(tyre.p.clone(), form);

@@ -1,21 +1,30 @@
 //! mf_stages — the Magic Formula as fitting problems: one [`MfStage`] per
 //! channel and group of `.tir` parameters (pure Fy, pure Fx, Mz, combined
-//! slip), with exact Jacobians by forward-mode automatic differentiation
-//! (the free parameters are seeded as `num-dual` dual numbers, eight at a
-//! time, and the crate's own [`crate::mf::Model::solve`] is evaluated over them).
+//! slip, Mx, My), with exact Jacobians by forward-mode automatic
+//! differentiation: the stage's free parameters are seeded as `num-dual`
+//! dual numbers, sixteen at a time (per lane the cheapest width of
+//! `DualSVec64` for these equations: 8 lanes ≈ 0.6 µs, 16 ≈ 0.9 µs, 32 ≈
+//! 6 µs per pure-Fy sample on the project machine), and only the fitted
+//! channel is evaluated ([`super::channels`], the same operations as
+//! [`crate::mf::Model::solve`]).
 //!
 //! Stage contents follow the usual industrial order (Pacejka, *Tyre and
 //! Vehicle Dynamics*, 3rd ed., §4.3.2 and Table 4.2): pure slip Fx
 //! (eqs. 4.E9–4.E18), pure slip Fy (4.E19–4.E30), aligning moment
-//! (4.E31–4.E49), then the combined-slip weighting functions (4.E50–4.E67).
-//! Scaling factors (λ) are never fitted.
+//! (4.E31–4.E49), then the combined-slip weighting functions (4.E50–4.E67),
+//! then the overturning and rolling-resistance moments where the data carry
+//! them (Mx: Besselink's MF 6.1 draft eq. 49; My: paper eq. A48).
+//! Scaling factors (λ) are never fitted. A large stage first converges on a
+//! subsample ([`fit_stage`], [`COARSE_SAMPLES`]).
 //!
 //! Must never: fit a scaling factor, move a camber (pressure) term when the
 //! fitted data hold one inclination (pressure) only — those are held and
 //! reported —, approximate a derivative by finite differences, or allocate
 //! per sample.
 
-use super::problem::{par_rows, Param, Problem};
+use super::channels;
+use super::problem::{par_rows, Param, Problem, Stack};
+use super::solve::{fit_global, FitOptions, FitOutcome, ProgressFn};
 use crate::data::{Recording, Sample, SegmentKind};
 use crate::mf::{Conditions, Form, MfInput, Model, Solution, UseMode};
 use crate::tir::keys::key_index;
@@ -23,10 +32,6 @@ use crate::tir::MfParams;
 use nalgebra::{Const, DMatrixViewMut, U1};
 use num_dual::{Derivative, DualSVec64};
 use std::ops::Range;
-
-/// Dual lanes per Jacobian pass (columns seeded at once).
-const LANES: usize = 8;
-type Lanes = DualSVec64<LANES>;
 
 /// A channel the Magic Formula predicts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -89,6 +94,10 @@ pub enum StageKind {
     PureFy,
     Mz,
     Combined,
+    /// Overturning moment (QSX*) over the pure lateral segments.
+    Mx,
+    /// Rolling resistance moment (QSY*) over the pure longitudinal segments.
+    My,
 }
 
 impl StageKind {
@@ -99,6 +108,8 @@ impl StageKind {
             "fy" => Some(StageKind::PureFy),
             "mz" => Some(StageKind::Mz),
             "combined" => Some(StageKind::Combined),
+            "mx" => Some(StageKind::Mx),
+            "my" => Some(StageKind::My),
             _ => None,
         }
     }
@@ -109,6 +120,8 @@ impl StageKind {
             StageKind::PureFy => "pure Fy",
             StageKind::Mz => "Mz",
             StageKind::Combined => "combined",
+            StageKind::Mx => "Mx",
+            StageKind::My => "My",
         }
     }
     /// The segments this stage fits, and the channels.
@@ -118,6 +131,8 @@ impl StageKind {
             StageKind::PureFy => (SegmentKind::PureLateral, &[Channel::Fy]),
             StageKind::Mz => (SegmentKind::PureLateral, &[Channel::Mz]),
             StageKind::Combined => (SegmentKind::Combined, &[Channel::Fx, Channel::Fy]),
+            StageKind::Mx => (SegmentKind::PureLateral, &[Channel::Mx]),
+            StageKind::My => (SegmentKind::PureLongitudinal, &[Channel::My]),
         }
     }
     /// The stage's parameters: (key, lower, upper, depends on camber, depends on pressure).
@@ -127,6 +142,8 @@ impl StageKind {
             StageKind::PureFx => FX,
             StageKind::Mz => MZ,
             StageKind::Combined => COMBINED,
+            StageKind::Mx => MX,
+            StageKind::My => MY,
         }
     }
 }
@@ -203,6 +220,30 @@ const COMBINED: &[(&str, f64, f64, bool, bool)] = &[
     ("rvy3", -50.0, 50.0, C, false),
 ];
 
+// Mx: Besselink's MF 6.1 draft eq. (49) as evaluated in `Model::mx`; My:
+// paper eq. A48 (MF 6.x) / the MF-Tyre 5.2 manual form. Speed terms of My
+// (QSY3, QSY4) are listed after QSY1: at one rig speed they are collinear
+// with it and held.
+#[rustfmt::skip]
+const MX: &[(&str, f64, f64, bool, bool)] = &[
+    ("qsx1", -0.2, 0.2, false, false), ("qsx3", -2.0, 2.0, false, false),
+    ("qsx13", -2.0, 2.0, false, false), ("qsx4", -20.0, 20.0, false, false),
+    ("qsx5", -100.0, 100.0, false, false), ("qsx6", -100.0, 100.0, false, false),
+    ("qsx8", -100.0, 100.0, false, false), ("qsx9", -100.0, 100.0, false, false),
+    ("qsx2", -20.0, 20.0, C, false), ("qsx7", -100.0, 100.0, C, false),
+    ("qsx10", -100.0, 100.0, C, false), ("qsx11", -100.0, 100.0, C, false),
+    ("qsx12", -100.0, 100.0, C, false), ("qsx14", -20.0, 20.0, C, false),
+    ("ppmx1", -10.0, 10.0, C, P),
+];
+#[rustfmt::skip]
+const MY: &[(&str, f64, f64, bool, bool)] = &[
+    ("qsy1", -0.2, 0.2, false, false), ("qsy2", -1.0, 1.0, false, false),
+    ("qsy3", -0.2, 0.2, false, false), ("qsy4", -0.2, 0.2, false, false),
+    ("qsy7", -2.0, 3.0, false, false),
+    ("qsy5", -5.0, 5.0, C, false), ("qsy6", -5.0, 5.0, C, false),
+    ("qsy8", -3.0, 3.0, false, P),
+];
+
 /// Spread of the fitted data below which camber (pressure) terms are held:
 /// 0.5° (5 kPa), well below any test plan's steps.
 pub const CAMBER_SPREAD: f64 = 0.5 * std::f64::consts::PI / 180.0;
@@ -217,6 +258,110 @@ pub struct StageData {
     /// Spread (max − min) of inclination and pressure over the samples.
     pub gamma_spread: f64,
     pub p_spread: f64,
+}
+
+impl StageData {
+    /// Every `k`-th sample (spreads kept: they decide which terms are held).
+    pub fn every(&self, k: usize) -> StageData {
+        let k = k.max(1);
+        StageData {
+            conds: self.conds.iter().step_by(k).copied().collect(),
+            meas: self
+                .meas
+                .iter()
+                .map(|m| m.iter().step_by(k).copied().collect())
+                .collect(),
+            gamma_spread: self.gamma_spread,
+            p_spread: self.p_spread,
+        }
+    }
+}
+
+/// Size of the subsample a large stage first converges on
+/// ([`crate::fit::FitOptions::coarse_first`]): stages with more than twice
+/// this many samples use every k-th sample with k = m / `COARSE_SAMPLES`.
+/// 10 000 samples determine ≈ 30 parameters to well within the sampling
+/// error of the full data's solution, so the full-data polish that follows
+/// takes two or three iterations.
+pub const COARSE_SAMPLES: usize = 10_000;
+
+/// Fit one Magic Formula stage: the `channels` of `data` (channel k ↔
+/// `data.meas[k]`; several channels are stacked with weights 1/mean(y²), so
+/// newtons and newton-metres compare) over `params`, from `base`, on
+/// `threads` threads; a stage with more than 2·[`COARSE_SAMPLES`] samples
+/// first converges on a subsample unless `opts.coarse_first` is off.
+#[allow(clippy::too_many_arguments)]
+pub fn fit_stage(
+    form: Form,
+    base: &MfParams<f64>,
+    params: &[Param],
+    data: &StageData,
+    channels: &[Channel],
+    threads: usize,
+    opts: &FitOptions,
+    name: &str,
+    progress: Option<&mut ProgressFn>,
+) -> crate::Result<FitOutcome> {
+    let m = data.conds.len();
+    let coarse =
+        (opts.coarse_first && m > 2 * COARSE_SAMPLES).then(|| data.every(m / COARSE_SAMPLES));
+    let weights: Vec<f64> = data
+        .meas
+        .iter()
+        .map(|y| {
+            let ms = y.iter().map(|v| v * v).sum::<f64>() / y.len().max(1) as f64;
+            if channels.len() > 1 && ms > 0.0 {
+                1.0 / ms
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    fn parts_of<'d>(
+        form: Form,
+        base: &MfParams<f64>,
+        params: &[Param],
+        d: &'d StageData,
+        channels: &[Channel],
+        weights: &[f64],
+        threads: usize,
+    ) -> crate::Result<Vec<MfStage<'d>>> {
+        channels
+            .iter()
+            .enumerate()
+            .map(|(k, &c)| {
+                Ok(MfStage::new(form, base, params.to_vec(), d, k, c)?
+                    .with_weight(weights[k])
+                    .with_threads(threads))
+            })
+            .collect()
+    }
+    let parts = parts_of(form, base, params, data, channels, &weights, threads)?;
+    let coarse_parts = match &coarse {
+        Some(d) => parts_of(form, base, params, d, channels, &weights, threads)?,
+        None => Vec::new(),
+    };
+    let (stack, coarse_stack);
+    let problem: &dyn Problem = if parts.len() == 1 {
+        &parts[0]
+    } else {
+        stack = Stack::new(parts.iter().map(|p| (p as &dyn Problem, 1.0)).collect())?;
+        &stack
+    };
+    let coarse_problem: Option<&dyn Problem> = match coarse_parts.len() {
+        0 => None,
+        1 => Some(&coarse_parts[0]),
+        _ => {
+            coarse_stack = Stack::new(
+                coarse_parts
+                    .iter()
+                    .map(|p| (p as &dyn Problem, 1.0))
+                    .collect(),
+            )?;
+            Some(&coarse_stack)
+        }
+    };
+    fit_global(problem, coarse_problem, None, None, opts, name, progress)
 }
 
 /// The use mode of fitting: no range limits (the start tyre's ranges must
@@ -394,6 +539,53 @@ impl<'a> MfStage<'a> {
     }
 }
 
+impl MfStage<'_> {
+    /// One Jacobian pass: the columns `chunk` (at most `N`) seeded as the
+    /// lanes of an `N`-lane dual number, written to columns `col0..` of `jac`
+    /// (and r on the first pass).
+    fn jacobian_pass<const N: usize>(
+        &self,
+        p: &MfParams<f64>,
+        chunk: &[usize],
+        col0: usize,
+        r: &mut [f64],
+        jac: &mut DMatrixViewMut<f64>,
+    ) {
+        // Seed lane l with the key of chunk[l].
+        let mut lane_of = [usize::MAX; N];
+        for (l, &c) in chunk.iter().enumerate() {
+            lane_of[l] = self.keys[c];
+        }
+        let pd: MfParams<DualSVec64<N>> =
+            p.map(|i, v| match lane_of.iter().position(|&k| k == i) {
+                Some(l) => DualSVec64::new(v, Derivative::derivative_generic(Const::<N>, U1, l)),
+                None => DualSVec64::from(v),
+            });
+        let model = Model::new(pd, self.form);
+        let width = chunk.len();
+        par_rows(
+            self.threads,
+            0,
+            r,
+            Some(jac),
+            &|first, r: &mut [f64], jac| {
+                let Some(jac) = jac else { return };
+                for (k, rk) in r.iter_mut().enumerate() {
+                    let i = first + k;
+                    let y = channels::eval(&model, &self.conds[i], self.channel);
+                    if col0 == 0 {
+                        *rk = y.re - self.meas[i];
+                    }
+                    let g = y.eps.unwrap_generic(Const::<N>, U1);
+                    for l in 0..width {
+                        jac[(k, col0 + l)] = g[l];
+                    }
+                }
+            },
+        );
+    }
+}
+
 impl Problem for MfStage<'_> {
     fn params(&self) -> &[Param] {
         &self.params
@@ -406,7 +598,7 @@ impl Problem for MfStage<'_> {
         par_rows(self.threads, 0, r, None, &|first, r: &mut [f64], _| {
             for (k, rk) in r.iter_mut().enumerate() {
                 let i = first + k;
-                *rk = self.channel.of(&model.solve(&self.conds[i])) - self.meas[i];
+                *rk = channels::eval(&model, &self.conds[i], self.channel) - self.meas[i];
             }
         });
     }
@@ -422,39 +614,20 @@ impl Problem for MfStage<'_> {
             self.residuals(theta, r);
             return;
         }
-        for (pass, chunk) in cols.chunks(LANES).enumerate() {
-            // Seed lane l with the key of cols[pass·LANES + l].
-            let mut lane_of = [usize::MAX; LANES];
-            for (l, &c) in chunk.iter().enumerate() {
-                lane_of[l] = self.keys[c];
+        // Passes of 16 lanes (the last one of 8 when that suffices): per lane
+        // the 16-lane dual is the cheapest num-dual width for these
+        // equations (wider vectors are slower per lane, see module docs).
+        let mut col0 = 0;
+        while col0 < cols.len() {
+            let rest = &cols[col0..];
+            if rest.len() <= 8 {
+                self.jacobian_pass::<8>(&p, rest, col0, r, jac);
+                col0 += rest.len();
+            } else {
+                let chunk = &rest[..rest.len().min(16)];
+                self.jacobian_pass::<16>(&p, chunk, col0, r, jac);
+                col0 += chunk.len();
             }
-            let pd: MfParams<Lanes> = p.map(|i, v| match lane_of.iter().position(|&k| k == i) {
-                Some(l) => Lanes::new(v, Derivative::derivative_generic(Const::<LANES>, U1, l)),
-                None => Lanes::from(v),
-            });
-            let model = Model::new(pd, self.form);
-            let width = chunk.len();
-            let col0 = pass * LANES;
-            par_rows(
-                self.threads,
-                0,
-                r,
-                Some(jac),
-                &|first, r: &mut [f64], jac| {
-                    let Some(jac) = jac else { return };
-                    for (k, rk) in r.iter_mut().enumerate() {
-                        let i = first + k;
-                        let y = self.channel.of(&model.solve(&self.conds[i]));
-                        if pass == 0 {
-                            *rk = y.re - self.meas[i];
-                        }
-                        let g = y.eps.unwrap_generic(Const::<LANES>, U1);
-                        for l in 0..width {
-                            jac[(k, col0 + l)] = g[l];
-                        }
-                    }
-                },
-            );
         }
     }
     fn weights(&self) -> Option<&[f64]> {

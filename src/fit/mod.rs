@@ -32,6 +32,7 @@
 //! fitted samples or on a [`Holdout`] split; [`FitReport`] prints tables and
 //! writes `fit.json`. Progress: pass `Some(&mut |p: &Progress| …)`.
 
+pub mod channels;
 pub mod holdout;
 pub mod identify;
 pub mod lm;
@@ -44,6 +45,7 @@ pub mod pso;
 pub mod recording;
 pub mod report;
 pub mod solve;
+pub mod transient;
 
 pub use holdout::{Holdout, Split};
 pub use identify::{IdentifyOptions, Verdict};

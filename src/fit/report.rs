@@ -10,6 +10,7 @@
 use super::identify::Verdict;
 use super::metrics::ChannelMetric;
 use super::solve::{FitOutcome, ParamStatus};
+use super::transient::RelaxationFit;
 
 /// Everything a fit produced, as written to `fit.json`.
 #[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
@@ -22,6 +23,9 @@ pub struct FitReport {
     pub metrics: Vec<ChannelMetric>,
     /// Metrics on held-out data (empty without `--holdout`).
     pub holdout_metrics: Vec<ChannelMetric>,
+    /// The relaxation-length stage, one entry per direction (empty unless run).
+    #[serde(default)]
+    pub relaxation: Vec<RelaxationFit>,
 }
 
 impl FitReport {
@@ -41,6 +45,10 @@ impl FitReport {
         let mut s = String::new();
         for st in &self.stages {
             s.push_str(&param_table(st));
+            s.push('\n');
+        }
+        if !self.relaxation.is_empty() {
+            s.push_str(&relaxation_table(&self.relaxation));
             s.push('\n');
         }
         if !self.metrics.is_empty() {
@@ -203,4 +211,48 @@ pub fn metrics_table(m: &[ChannelMetric]) -> String {
         ],
         &rows,
     )
+}
+
+/// The relaxation stage: per direction the key, start and fitted value, the
+/// relaxation length at FNOMIN, and the replay cost of the steady model, the
+/// start and the fit.
+pub fn relaxation_table(r: &[RelaxationFit]) -> String {
+    let rows: Vec<Vec<String>> = r
+        .iter()
+        .map(|x| {
+            vec![
+                x.channel.clone(),
+                x.key.clone(),
+                format!("{:.6e}", x.start),
+                format!("{:.6e}", x.value),
+                format!("{:.4}", x.sigma_start),
+                format!("{:.4}", x.sigma),
+                format!("{:.4e}", x.cost_steady),
+                format!("{:.4e}", x.cost),
+                if x.identified {
+                    "fitted".to_string()
+                } else {
+                    format!("held: {}", x.note)
+                },
+            ]
+        })
+        .collect();
+    let mut s = String::from(
+        "Stage transient (relaxation lengths, replayed through the relaxation model)\n",
+    );
+    s.push_str(&table(
+        &[
+            "channel",
+            "key",
+            "start",
+            "fitted",
+            "σ start (m)",
+            "σ fitted (m)",
+            "cost steady",
+            "cost fitted",
+            "status",
+        ],
+        &rows,
+    ));
+    s
 }

@@ -18,6 +18,13 @@ pub struct FitOptions {
     /// Global start by particle swarm (needs finite bounds on the free parameters).
     pub pso: Option<PsoOptions>,
     pub identify: IdentifyOptions,
+    /// With a subsampled problem given to [`fit_global`]: converge the LM on
+    /// it first (to a loose tolerance, 1e-6), then polish on all samples.
+    /// The subsample's optimum is within sampling error of the full one, so
+    /// the full-data polish needs few of the expensive iterations; the result
+    /// (final cost, held set, standard errors) is always the full problem's.
+    #[serde(default)]
+    pub coarse_first: bool,
 }
 
 /// What is happening, for a progress display.
@@ -121,6 +128,7 @@ pub fn fit(
 /// [`fit`] with the swarm run on `swarm_problem` (same parameter table, e.g.
 /// every 20th sample: the swarm needs thousands of cost evaluations, the
 /// polish a dozen). `FitOutcome::swarm_cost` is then that problem's cost.
+/// With [`FitOptions::coarse_first`] the LM also converges on it first.
 pub fn fit_global(
     problem: &dyn Problem,
     swarm_problem: Option<&dyn Problem>,
@@ -232,14 +240,42 @@ pub fn fit_global(
     // A candidate whose polish fails (e.g. the model is undefined there) is
     // skipped; the fit fails only if every candidate does.
     let mut first_err = None;
-    for (which, cand) in starts.into_iter().enumerate() {
+    // After a coarse solution the polish starts close to the optimum: small
+    // initial damping (Madsen, Nielsen & Tingleff 2004, §3.2: τ = 1e-6 for a
+    // start believed to be good), so it takes Gauss–Newton steps at once.
+    let mut near = opts.clone();
+    near.lm.lambda0 = near.lm.lambda0.min(1e-6);
+    for (which, mut cand) in starts.into_iter().enumerate() {
+        let mut polish_opts = None;
+        if opts.coarse_first && !std::ptr::addr_eq(swarm_problem, problem) {
+            let mut loose = opts.clone();
+            loose.lm.ftol = loose.lm.ftol.max(1e-6);
+            loose.lm.xtol = loose.lm.xtol.max(1e-6);
+            loose.lm.gtol = loose.lm.gtol.max(1e-6);
+            let mut cws = Workspace::new(swarm_problem.n_residuals(), 0);
+            // A failing coarse polish leaves the candidate as it was.
+            if let Ok(c) = polish(
+                swarm_problem,
+                cand.clone(),
+                (which, n_starts),
+                &theta0,
+                &free_in,
+                &loose,
+                stage,
+                progress.as_deref_mut(),
+                &mut cws,
+            ) {
+                cand = c.theta;
+                polish_opts = Some(&near);
+            }
+        }
         let p = match polish(
             problem,
             cand,
             (which, n_starts),
             &theta0,
             &free_in,
-            opts,
+            polish_opts.unwrap_or(opts),
             stage,
             progress.as_deref_mut(),
             &mut ws,

@@ -618,6 +618,46 @@ impl<T: Real> Model<T> {
         (fx, fy)
     }
 
+    /// Single channels of [`Model::solve`] (same operations, so the same
+    /// values) for the fitter, which needs one channel per stage:
+    /// `fy` = Gyκ·Fy0 + SVyκ (4.E58), `fx` = Gxα·Fx0 (4.E50), and Mx, My from
+    /// them. Turn slip is not evaluated (the fitter's use mode has none).
+    pub(crate) fn fx_only(&self, c: &Conditions) -> T {
+        let mut fl = 0u32;
+        let (dfz, dpi) = self.load_pressure(c);
+        let gx = T::c(c.gamma) * self.lgax;
+        let (fx0, _, _) = self.fx0(c, dfz, dpi, T::c(1.0), gx, self.p.lmux, true, &mut fl);
+        self.gxa(c, dfz, T::c(c.gamma_star) * self.lgax, &mut fl) * fx0
+    }
+
+    /// See [`Model::fx_only`].
+    pub(crate) fn fy_only(&self, c: &Conditions) -> T {
+        let mut fl = 0u32;
+        let (dfz, dpi) = self.load_pressure(c);
+        let gs_y = T::c(c.gamma_star) * self.lgay;
+        let f = self.fy0(c, dfz, dpi, gs_y, None, self.p.lmuy, None, true, &mut fl);
+        let (gyk, svyk_unit) = self.gyk(c, dfz, gs_y, &mut fl);
+        gyk * f.fy0 + svyk_unit * f.muy * f.zeta2
+    }
+
+    /// See [`Model::fx_only`].
+    pub(crate) fn mx_only(&self, c: &Conditions) -> T {
+        self.mx(c, self.load_pressure(c).1, self.fy_only(c))
+    }
+
+    /// See [`Model::fx_only`].
+    pub(crate) fn my_only(&self, c: &Conditions) -> T {
+        self.my(c, self.fx_only(c))
+    }
+
+    /// Normalised load and pressure change (4.E2a, 4.E2b), as in `pure`.
+    #[inline(always)]
+    fn load_pressure(&self, c: &Conditions) -> (T, T) {
+        let dfz = (T::c(c.fz) - self.fz0p) * self.inv_fz0p;
+        let dpi = (T::c(c.p) - self.p.nompres) * self.inv_nompres;
+        (dfz, dpi)
+    }
+
     /// Forces and moments for combined slip (and the by-products).
     #[inline]
     pub fn solve(&self, c: &Conditions) -> Solution<T> {

@@ -1,0 +1,26 @@
+//! channels — one Magic Formula channel at a time, for the fit stages: a
+//! stage fits one channel (Fx, Fy, Mx, My or Mz), and evaluating only that
+//! channel (with dual lanes only for the stage's free parameters) is several
+//! times cheaper than the full combined-slip solution with all five.
+//!
+//! The values are those of [`crate::mf::Model::solve`] (same operations in
+//! the same order: `tests/fit_channels.rs` checks bit equality for `f64` and
+//! the derivatives against the full solution's).
+//!
+//! Must never: evaluate anything differently from `Model::solve`, or be used
+//! with turn slip (the fitter's use mode has none).
+
+use super::mf_stages::Channel;
+use crate::mf::{Conditions, Model, Real};
+
+/// `channel` of `model` at `c`: the same value as `channel.of(&model.solve(c))`.
+#[inline]
+pub fn eval<T: Real>(model: &Model<T>, c: &Conditions, channel: Channel) -> T {
+    match channel {
+        Channel::Fx => model.fx_only(c),
+        Channel::Fy => model.fy_only(c),
+        Channel::Mx => model.mx_only(c),
+        Channel::My => model.my_only(c),
+        Channel::Mz => model.solve(c).mz,
+    }
+}

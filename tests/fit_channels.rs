@@ -1,0 +1,104 @@
+//! The fitter's one-channel evaluation (`tyrekit::fit::channels::eval`)
+//! against the full combined-slip solution (`Model::solve`): for MF 6.1,
+//! MF 5.2 and PAC2002 files, over loads, slips (κ and α both non-zero, so
+//! the combined-slip weights act), inclinations and pressures, the `f64`
+//! values are bit-identical and the dual-number derivatives agree to
+//! rounding (1e-12 relative: the same operations, except that the full
+//! solution's Fy reuses Fy0 computed once for Mz, which can reorder nothing
+//! that changes the derivative beyond an ulp or two).
+
+mod common;
+
+use tyrekit::fit::channels::eval;
+use tyrekit::fit::mf_stages::{conditions_of, Channel};
+use tyrekit::mf::num_dual::Dual64;
+use tyrekit::mf::{form_of, Model};
+use tyrekit::tir::keys::key_index;
+use tyrekit::tir::TyreParams;
+
+const CHANNELS: [Channel; 5] = [
+    Channel::Fx,
+    Channel::Fy,
+    Channel::Mx,
+    Channel::My,
+    Channel::Mz,
+];
+
+fn tyres() -> Vec<TyreParams> {
+    let mut v = vec![TyreParams::builtin()];
+    for f in ["MagicFormula52_Parameters.tir", "Generic_Pac02Tire.tir"] {
+        let p = common::shared().join("data/tir").join(f);
+        if p.exists() {
+            v.push(TyreParams::from_file(&p).unwrap());
+        } else {
+            eprintln!("SKIP {}: absent", p.display());
+        }
+    }
+    v
+}
+
+fn samples(t: &TyreParams) -> Vec<tyrekit::data::Sample> {
+    let p = &t.p;
+    let mut out = Vec::new();
+    for i in 0..400 {
+        let x = i as f64;
+        out.push(tyrekit::data::Sample {
+            fz: p.fnomin * (0.2 + 1.6 * ((x * 0.37).sin() * 0.5 + 0.5)),
+            kappa: 0.15 * (x * 0.71).sin(),
+            alpha: 0.2 * (x * 0.53).cos(),
+            gamma: 0.06 * (x * 0.29).sin(),
+            p: p.nompres * (1.0 + 0.15 * (x * 0.13).cos()),
+            vx: 15.0 + 5.0 * (x * 0.11).sin(),
+            ..Default::default()
+        });
+    }
+    out
+}
+
+#[test]
+fn one_channel_values_are_bit_identical_to_solve() {
+    for t in tyres() {
+        let m = Model::new(t.p.clone(), form_of(t.version));
+        for s in samples(&t) {
+            let c = conditions_of(&t.p, &s);
+            let full = m.solve(&c);
+            for ch in CHANNELS {
+                let (a, b) = (eval(&m, &c, ch), ch.of(&full));
+                assert_eq!(a.to_bits(), b.to_bits(), "{} {ch:?}: {a} vs {b}", t.source);
+            }
+        }
+    }
+}
+
+#[test]
+fn one_channel_derivatives_match_solve() {
+    // A parameter of every stage: Fx, Fy, Mz, combined, Mx, My terms.
+    let keys = [
+        "PKX1", "PEX1", "PKY1", "PEY2", "QBZ1", "RBY1", "QSX3", "QSY1",
+    ];
+    for t in tyres() {
+        for k in keys {
+            let ki = key_index(k).unwrap();
+            let pd = t.p.map(|i, v| {
+                if i == ki {
+                    Dual64::new(v, 1.0)
+                } else {
+                    Dual64::from(v)
+                }
+            });
+            let m = Model::new(pd, form_of(t.version));
+            for s in samples(&t).iter().step_by(7) {
+                let c = conditions_of(&t.p, s);
+                let full = m.solve(&c);
+                for ch in CHANNELS {
+                    let (a, b) = (eval(&m, &c, ch).eps, ch.of(&full).eps);
+                    assert!(
+                        (a - b).abs() <= 1e-12 * b.abs().max(1e-300),
+                        "{} {ch:?} d/d{k}: {a} vs {b}",
+                        t.source
+                    );
+                }
+            }
+        }
+    }
+}

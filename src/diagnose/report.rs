@@ -472,7 +472,7 @@ pub fn diagnose_with(
     let test_mask = mask(&test_r);
     let mut effects = Vec::new();
     let mut order: Vec<usize> = (0..ev.len()).collect();
-    order.sort_by_key(|&i| usize::from(Some(i) != verdict_i));
+    order.sort_by_key(|&i| usize::from(ev[i].0.name != verdict));
     let before = nrmse_map(rec, &base.sim, None);
     let before_oos = nrmse_map(rec, &base.sim, Some(&test_mask));
     let mut extended_sim = base.sim.clone();

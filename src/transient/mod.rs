@@ -50,11 +50,13 @@
 //! | 0    | `u`: longitudinal deflection (m), κ' = u/σκ | `zx`: longitudinal bristle (m) |
 //! | 1    | `v`: lateral deflection (m), tan α' = v/σα | `zy`: lateral bristle (m)      |
 //! | 2    | `φ'`: lagged turn slip (1/m)            | –                             |
-//! | 3–7  | reserved (0)                             | reserved (0)                  |
+//! | 3    | tread temperature rise ΔT (K), any model with a `[THERMAL]` extension ([`extension`]) |
+//! | 4–7  | reserved (0)                             | reserved (0)                  |
 //!
 //! The `Steady` model has no state (all slots stay 0). The all-zero state is
 //! the state at rest (what [`TransientModel::reset`] restores).
 
+pub mod extension;
 pub mod lugre;
 pub mod scenario;
 
@@ -564,6 +566,8 @@ pub(crate) struct StepCtx<'a> {
     pub kin: Kinematics,
     pub props: TyreProps,
     pub s: f64,
+    /// Slip-stiffness scale of the extension (1 without one).
+    pub c: f64,
     pub fz: f64,
     pub omega_re: f64,
     /// Whether the force evaluation runs at a raised speed (|Vx| < VXLOW).
@@ -589,7 +593,18 @@ impl StepCtx<'_> {
             kappa: self.dir * sl.kappa,
             ..sl
         };
-        mf_at(self.tyre, base, self.mode, sl, self.s)
+        mf_at(self.tyre, base, self.mode, self.stiff(sl), self.s)
+    }
+
+    /// The slips scaled by the extension's slip-stiffness scale `c`
+    /// (similarity method: stiffness × c); unchanged when c = 1.
+    #[inline]
+    pub fn stiff(&self, sl: Slip) -> Slip {
+        if self.c == 1.0 {
+            sl
+        } else {
+            Slip::new(self.c * sl.kappa, self.c * sl.tan_alpha)
+        }
     }
 
     /// Low-speed offset correction (N): the MF's force at zero slip at the
@@ -664,6 +679,16 @@ impl TransientModel {
         let probe = tyre.slip_properties(&base, mode);
         let props = tyre_props(tyre, &probe, fz, inp.vx.abs());
         let kin = kinematics(self.config.input_mode, inp, props.re);
+        // The extension hook (friction and slip-stiffness scales, see
+        // `extension`); a tyre without one keeps s and c = 1 untouched.
+        let ext = tyre.extension();
+        let (s, c) = match ext {
+            Some(e) => {
+                let (es, ec) = e.scales(&self.state, fz, &kin);
+                (s * es, ec)
+            }
+            None => (s, 1.0),
+        };
         let steady = self.config.kind == TransientKind::Steady;
         // The force evaluation. Transient models: speed of the sign of Vx
         // and magnitude ≥ VXLOW, so that the MF's steady-state low-speed slip
@@ -688,6 +713,7 @@ impl TransientModel {
             kin,
             props,
             s,
+            c,
             fz,
             omega_re: inp.omega * props.re,
             floored: fbase.vx != base.vx,
@@ -722,7 +748,7 @@ impl TransientModel {
             if self.config.input_mode == InputMode::Velocities && inp.vx < 0.0 {
                 sl.kappa = -sl.kappa;
             }
-            self.output(&ctx, &mf_at(tyre, &fbase, mode, sl, s), sl)
+            self.output(&ctx, &mf_at(tyre, &fbase, mode, ctx.stiff(sl), s), sl)
         } else {
             match self.config.kind {
                 TransientKind::Relaxation => {
@@ -750,6 +776,9 @@ impl TransientModel {
                 _ => lugre::step(&ctx, &self.options.lugre, &mut next, dt),
             }
         };
+        if let Some(e) = ext {
+            e.advance(&self.state, &mut next, &out, dt);
+        }
         if !steady && fz > FZ_OFF {
             // Rolling resistance at the actual speed and direction (the MF's
             // own low-speed treatment), from the zero-slip probe.

@@ -16,9 +16,8 @@ use crate::fit::metrics::nrmse;
 use crate::mf::{Forces, Tyre};
 use serde_json::{json, Map, Value};
 
-/// Smallest held-out gain (share of the baseline's held-out SSE removed)
-/// that names an effect.
-pub const MIN_GAIN: f64 = 0.05;
+/// Smallest held-out gain that names an effect (the rule: [`super::candidate::select`]).
+pub use super::candidate::MIN_GAIN;
 
 /// NRMSE per channel (FX, FY, MZ) of `sim` against the recording.
 pub fn nrmse_map(rec: &Recording, sim: &[Forces]) -> Value {
@@ -92,9 +91,7 @@ pub fn diagnose(rec: &Recording, tyre: &Tyre, opts: &ReplayOptions) -> Result<Di
     let cands: Vec<&dyn Candidate> = owned.iter().map(|c| c.as_ref()).collect();
     let ev = evaluate(rec, tyre, opts, &cands)?;
     let before = nrmse_map(rec, &base.sim);
-    let best = ev
-        .iter()
-        .find(|(e, _)| e.name != "none" && e.oos_gain > MIN_GAIN && e.delta_bic < 0.0);
+    let best = super::candidate::select(&ev).map(|i| &ev[i]);
     let verdict = best.map_or("none".to_string(), |(e, _)| e.name.clone());
     let mut effects = Vec::new();
     let mut order: Vec<usize> = (0..ev.len()).collect();

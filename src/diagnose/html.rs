@@ -124,7 +124,7 @@ figcaption{{font-size:.9em;color:#444}} details{{margin:1em 0}}\
             );
         }
     }
-    s.push_str("</table>\n<p><small>Held-out gain: share of the baseline's squared error (FX, FY, MZ, each over its variance) removed on the segments the candidate was not fitted on (fitted on even segments, scored on odd ones). ΔBIC over the whole recording with an effective sample count of n/50 (rig channels are strongly autocorrelated): negative = the extra parameters pay for themselves.</small></p>\n");
+    s.push_str("</table>\n<p><small>Held-out gain: share of the baseline's squared error (FX, FY, MZ, each over its variance) removed on the segments the candidate was not fitted on (the segments alternate between the halves within each group of kind and load); constant channel offsets are estimated on the fit half and removed. ΔBIC over the whole recording with an effective sample count of n/50 (rig channels are strongly autocorrelated): negative = the extra parameters pay for themselves.</small></p>\n");
     // Locate.
     s.push_str("<h2>Where the residual concentrates (baseline)</h2>\n<p><small>Each grouping: a statistic, its permutation p-value (segment-level groupings permute segments; sample-level ones shift each segment's residual circularly, keeping its autocorrelation), Holm-adjusted over the groupings of the channel; significant rows highlighted (family-wise 5 %).</small></p>\n");
     for (ch, f) in &d.findings {
@@ -152,7 +152,7 @@ figcaption{{font-size:.9em;color:#444}} details{{margin:1em 0}}\
     let _ = write!(
         s,
         "<h2>Fit before and after</h2>\n<p>σ = √(Σ(sim − test)²/Σ test²), NRMSE = RMS(sim − test)/range(test); \
-before = baseline, after = {} model.</p>\n<h3>Out of sample (held-out segments)</h3>\n{}\
+before = baseline, after = {} model; each model's constant channel offset (sensor zero) estimated on the fit half and removed.</p>\n<h3>Out of sample (held-out segments)</h3>\n{}\
 <details><summary>In sample (segments the candidates were fitted on)</summary>\n{}</details>\n",
         esc(&d.verdict),
         quality_table(&d.out_of_sample),

@@ -10,14 +10,15 @@
 //! extended model ("after"), per channel (FX, FY, MZ), over all samples and
 //! per condition (load, inclination, pressure; and per speed when the
 //! recording has more than one), on the segments the candidates were fitted
-//! on (`in_sample`, even segments) and on those they never saw
-//! (`out_of_sample`, odd segments) — the split of [`super::candidate::evaluate`].
+//! on (`in_sample`) and on those they never saw (`out_of_sample`) — the
+//! split of [`super::candidate::split`]. These are the raw residuals (no
+//! offsets removed), as a user would compute them from `replay`.
 //!
 //! # Explanation
 //! The significant [`locate`] findings of each channel are put in words
 //! ("the FY residual changes with the sweep direction (rising − falling
-//! +41 N) and follows the force rate"), then the verdict's physics
-//! ([`Candidate::physics`]), its fitted parameters ([`Candidate::describe`])
+//! +41 N) and follows the force rate"), then the verdict's physics and its
+//! fitted parameters in words ([`Evaluation::physics`], [`Evaluation::describe`])
 //! and the share of the held-out error it removes. For `none` the text
 //! says whether the residual showed structure at all and what the best
 //! candidate achieved.
@@ -26,7 +27,7 @@
 //! (the selection rule decides), or call a grouping significant that
 //! [`locate`] did not.
 
-use super::candidate::{all, evaluate, Candidate, Evaluation, Fitted, CHANNELS};
+use super::candidate::{all, evaluate, select, Candidate, Evaluation, CHANNELS};
 use super::locate::{frictional_energy, locate, Finding, LocateOptions, Residuals};
 use super::replay::{replay, ReplayOptions};
 use crate::data::Recording;
@@ -36,9 +37,8 @@ use crate::mf::{Forces, Tyre};
 use serde_json::{json, Map, Value};
 use std::ops::Range;
 
-/// Smallest held-out gain (share of the baseline's held-out SSE removed)
-/// that names an effect.
-pub const MIN_GAIN: f64 = 0.05;
+/// Smallest held-out gain that names an effect (the rule: [`super::candidate::select`]).
+pub use super::candidate::MIN_GAIN;
 
 /// The channels the report scores and plots: (name, unit).
 pub const REPORT_CHANNELS: [(&str, &str); 3] = [("FX", "N"), ("FY", "N"), ("MZ", "N m")];
@@ -123,28 +123,28 @@ pub fn locate_channel(
     locate(&d, &LocateOptions::default())
 }
 
-/// The candidates' split: samples of even segments (fit) and odd ones
-/// (held out), as [`super::candidate::evaluate`] makes it.
+/// The candidates' split ([`super::candidate::split`]) as sample ranges:
+/// (fit half, held-out half).
 pub fn split(rec: &Recording) -> (Vec<Range<usize>>, Vec<Range<usize>>) {
-    let n = rec.samples.len();
-    let (mut fit, mut test) = (Vec::new(), Vec::new());
-    for (k, g) in rec.segments.iter().enumerate() {
-        let r = g.start.min(n)..g.end.min(n);
-        if k % 2 == 0 {
-            fit.push(r);
-        } else {
-            test.push(r);
-        }
-    }
-    (fit, test)
+    let (fit, test) = super::candidate::split(rec);
+    (ranges(&fit), ranges(&test))
 }
 
-/// The verdict among the evaluations (sorted best first): the first
-/// candidate other than `none` whose held-out gain exceeds [`MIN_GAIN`] and
-/// whose BIC falls.
-fn select(ev: &[(Evaluation, Box<dyn Fitted>)]) -> Option<usize> {
-    ev.iter()
-        .position(|(e, _)| e.name != "none" && e.oos_gain > MIN_GAIN && e.delta_bic < 0.0)
+/// The runs of `true` in `mask` as half-open ranges.
+fn ranges(mask: &[bool]) -> Vec<Range<usize>> {
+    let mut out = Vec::new();
+    let mut start = None;
+    for (i, &m) in mask.iter().chain(std::iter::once(&false)).enumerate() {
+        match (m, start) {
+            (true, None) => start = Some(i),
+            (false, Some(a)) => {
+                out.push(a..i);
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    out
 }
 
 /// One row of the quality table.
@@ -160,11 +160,33 @@ pub struct QualityRow {
     pub nrmse_after: f64,
 }
 
-/// Before/after σ and NRMSE per channel and condition over `ranges`.
+/// `sim` plus its constant offset from the measurement, estimated as the
+/// mean of (measured − sim) over `fit` (the fit half only, so the held-out
+/// half stays unseen).
+fn with_offset(y: &[f64], sim: &[f64], fit: &[Range<usize>]) -> Vec<f64> {
+    let (mut s, mut n) = (0.0, 0.0);
+    for r in fit {
+        for i in r.clone() {
+            let d = y[i] - sim[i];
+            if d.is_finite() {
+                s += d;
+                n += 1.0;
+            }
+        }
+    }
+    let o = if n > 0.0 { s / n } else { 0.0 };
+    sim.iter().map(|v| v + o).collect()
+}
+
+/// Before/after σ and NRMSE per channel and condition over `ranges`. Each
+/// model's constant channel offset (a sensor zero, not physics — the
+/// scoring of the candidates treats it so too) is estimated on the fit
+/// half `fit` and removed first.
 pub fn quality(
     rec: &Recording,
     before: &[Forces],
     after: &[Forces],
+    fit: &[Range<usize>],
     ranges: &[Range<usize>],
 ) -> Result<Vec<QualityRow>> {
     let mut rows = Vec::new();
@@ -179,6 +201,7 @@ pub fn quality(
         };
         let (_, sb, _) = channel_series(rec, before, ch);
         let (y, sa, _) = channel_series(rec, after, ch);
+        let (sb, sa) = (with_offset(&y, &sb, fit), with_offset(&y, &sa, fit));
         let mb = metrics::evaluate(rec, name, &sb, Some(ranges))?;
         let ma = metrics::evaluate(rec, name, &sa, Some(ranges))?;
         for (b, a) in mb.iter().zip(&ma) {
@@ -333,7 +356,7 @@ fn set_point(grouping: &str, x: f64) -> String {
 /// The explanation of the verdict (see the module docs).
 pub fn explain(
     findings: &[(&'static str, Vec<Finding>)],
-    verdict: Option<(&dyn Candidate, &Evaluation, &dyn Fitted)>,
+    verdict: Option<&Evaluation>,
     best_other: Option<&Evaluation>,
     alpha: f64,
 ) -> String {
@@ -353,13 +376,13 @@ pub fn explain(
         Some(where_.join("; "))
     };
     match verdict {
-        Some((c, e, fitted)) => format!(
-            "{}: the model lacks {}; {} removes {:.0} % of the baseline's error on held-out segments (BIC {:+.1}).",
+        Some(e) => format!(
+            "{}. Missing from the model: {}. {} removes {:.0} % of the baseline's error on held-out segments (BIC {:+.1}).",
             capitalise(located.as_deref().unwrap_or(
                 "no single grouping of the residual is significant on its own"
             )),
-            c.physics(),
-            c.describe(fitted),
+            e.physics,
+            capitalise(&e.describe),
             100.0 * e.oos_gain,
             e.delta_bic
         ),
@@ -483,7 +506,6 @@ pub fn diagnose_with(
         } else {
             fitted.predict(rec)?
         };
-        let cand = owned.iter().find(|c| c.name() == e.name);
         let params: Map<String, Value> = e
             .parameters
             .iter()
@@ -495,12 +517,12 @@ pub fn diagnose_with(
             "delta_bic": e.delta_bic,
             "n_params": e.n_params,
             "evidence": format!(
-                "{}fitted on even segments, scored on odd ones: removes {:.1} % of the baseline's held-out squared error (BIC change {:+.1})",
-                cand.map_or(String::new(), |c| if e.name == "none" {
+                "{}fitted on one half of the segments, scored on the other: removes {:.1} % of the baseline's held-out squared error (BIC change {:+.1})",
+                if e.name == "none" {
                     String::new()
                 } else {
-                    format!("{}: {}; ", c.physics(), c.describe(fitted.as_ref()))
-                }),
+                    format!("{}: {}; ", e.physics, e.describe)
+                },
                 100.0 * e.oos_gain,
                 e.delta_bic
             ),
@@ -516,23 +538,9 @@ pub fn diagnose_with(
     }
     let best_other = ev.iter().find(|(e, _)| e.name != "none").map(|(e, _)| e);
     let alpha = LocateOptions::default().alpha;
-    let explanation = match verdict_i {
-        Some(i) => {
-            let (e, f) = &ev[i];
-            match owned.iter().find(|c| c.name() == e.name) {
-                Some(c) => explain(
-                    &findings,
-                    Some((c.as_ref(), e, f.as_ref())),
-                    best_other,
-                    alpha,
-                ),
-                None => explain(&findings, None, best_other, alpha),
-            }
-        }
-        None => explain(&findings, None, best_other, alpha),
-    };
-    let in_sample = quality(rec, &base.sim, &extended_sim, &fit_r)?;
-    let out_of_sample = quality(rec, &base.sim, &extended_sim, &test_r)?;
+    let explanation = explain(&findings, verdict_i.map(|i| &ev[i].0), best_other, alpha);
+    let in_sample = quality(rec, &base.sim, &extended_sim, &fit_r, &fit_r)?;
+    let out_of_sample = quality(rec, &base.sim, &extended_sim, &fit_r, &test_r)?;
     let mut loc = Map::new();
     for (ch, f) in &findings {
         loc.insert((*ch).into(), serde_json::to_value(f).unwrap_or(Value::Null));
@@ -544,7 +552,7 @@ pub fn diagnose_with(
         "effects": effects,
         "quality": {
             "model_after": verdict,
-            "split": "candidates fitted on even segments (in_sample), scored on odd ones (out_of_sample)",
+            "split": "candidates fitted on one half of the segments (in_sample), scored on the other (out_of_sample); halves alternate within each (kind, load) group",
             "in_sample": in_sample,
             "out_of_sample": out_of_sample,
         },

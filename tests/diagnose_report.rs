@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use tyrekit::diagnose::locate::Finding;
-use tyrekit::diagnose::report::findings_in_words;
+use tyrekit::diagnose::report::{caution, findings_in_words, QualityRow};
 use tyrekit::mf::Tyre;
 use tyrekit::rig::{effects, simulate, RigConfig};
 
@@ -201,4 +201,27 @@ fn findings_in_words_names_the_signatures() {
     assert!(w.contains("+2.1 % at 2000 N, -3.4 % at 6000 N"), "{w}");
     assert!(!w.contains("time in the run"), "{w}");
     assert!(findings_in_words(&f[3..], "N").is_none());
+}
+
+fn row(channel: &'static str, before: f64, after: f64) -> QualityRow {
+    QualityRow {
+        channel,
+        condition: "all".into(),
+        n: 1000,
+        sigma_before: before,
+        sigma_after: after,
+        nrmse_before: before / 3.0,
+        nrmse_after: after / 3.0,
+    }
+}
+
+/// A verdict that makes one channel's held-out σ worse by more than 10 %
+/// while another gains is flagged; small changes are not.
+#[test]
+fn caution_when_a_channel_gets_worse() {
+    let c = caution(&[row("FY", 0.047, 0.063), row("MZ", 0.22, 0.19)]).unwrap();
+    assert!(c.contains("Fy (held-out σ 4.70 % → 6.30 %)"), "{c}");
+    assert!(c.contains("from Mz alone"), "{c}");
+    // 5 % worse is within the scatter between halves: no caution.
+    assert!(caution(&[row("FY", 0.040, 0.042), row("MZ", 0.22, 0.10)]).is_none());
 }

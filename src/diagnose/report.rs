@@ -410,6 +410,51 @@ pub fn explain(
     }
 }
 
+/// Relative rise of a channel's held-out σ above which the verdict's
+/// explanation carries a caution (10 %: well above the run-to-run scatter
+/// of σ between the halves, far below what a real improvement shows).
+pub const WORSE: f64 = 0.10;
+
+/// A caution when the verdict's model makes a channel's held-out fit worse
+/// by more than [`WORSE`] (relative σ) while others gain: a tyre engineer
+/// would then suspect the gain comes from another misfit of the baseline
+/// that the extension happens to absorb, not from the named physics.
+pub fn caution(out_of_sample: &[QualityRow]) -> Option<String> {
+    let all: Vec<&QualityRow> = out_of_sample
+        .iter()
+        .filter(|r| r.condition == "all" && r.sigma_before.is_finite() && r.sigma_after.is_finite())
+        .collect();
+    let worse: Vec<String> = all
+        .iter()
+        .filter(|r| r.sigma_after > (1.0 + WORSE) * r.sigma_before)
+        .map(|r| {
+            format!(
+                "{} (held-out σ {:.2} % → {:.2} %)",
+                pretty(r.channel),
+                100.0 * r.sigma_before,
+                100.0 * r.sigma_after
+            )
+        })
+        .collect();
+    if worse.is_empty() {
+        return None;
+    }
+    let better: Vec<&str> = all
+        .iter()
+        .filter(|r| r.sigma_after < r.sigma_before)
+        .map(|r| pretty(r.channel))
+        .collect();
+    Some(format!(
+        "Caution: it makes {} worse{}; the verdict is doubtful — the gain may be another misfit of the baseline that this extension absorbs.",
+        worse.join(" and "),
+        if better.is_empty() {
+            String::new()
+        } else {
+            format!(", the gain comes from {} alone", better.join(" and "))
+        }
+    ))
+}
+
 /// The channel's name as engineers write it (FX → Fx).
 pub fn pretty(ch: &str) -> &'static str {
     match ch {
@@ -538,9 +583,15 @@ pub fn diagnose_with(
     }
     let best_other = ev.iter().find(|(e, _)| e.name != "none").map(|(e, _)| e);
     let alpha = LocateOptions::default().alpha;
-    let explanation = explain(&findings, verdict_i.map(|i| &ev[i].0), best_other, alpha);
     let in_sample = quality(rec, &base.sim, &extended_sim, &fit_r, &fit_r)?;
     let out_of_sample = quality(rec, &base.sim, &extended_sim, &fit_r, &test_r)?;
+    let mut explanation = explain(&findings, verdict_i.map(|i| &ev[i].0), best_other, alpha);
+    if verdict_i.is_some() {
+        if let Some(c) = caution(&out_of_sample) {
+            explanation.push(' ');
+            explanation.push_str(&c);
+        }
+    }
     let mut loc = Map::new();
     for (ch, f) in &findings {
         loc.insert((*ch).into(), serde_json::to_value(f).unwrap_or(Value::Null));

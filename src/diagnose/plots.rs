@@ -143,12 +143,13 @@ fn panel(
     Ok(())
 }
 
+/// The panels of a figure.
+type Areas<'a> = [DrawingArea<SVGBackend<'a>, Shift>];
+/// A curve as (x, y) points.
+type Curve = Vec<(f64, f64)>;
+
 /// A figure of `cols` panels side by side.
-fn figure(
-    path: &Path,
-    cols: usize,
-    draw: &dyn Fn(&[DrawingArea<SVGBackend, Shift>]) -> Result<()>,
-) -> Result<()> {
+fn figure(path: &Path, cols: usize, draw: &dyn Fn(&Areas) -> Result<()>) -> Result<()> {
     let root = SVGBackend::new(path, (560 * cols as u32, 440)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| perr(path, e))?;
     let areas = root.split_evenly((1, cols));
@@ -395,7 +396,7 @@ fn residual_load(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
 }
 
 /// Mean of y per x bin over `idx`, rising and falling sweeps apart.
-fn binned(c: &Chan, idx: &[usize], y: &dyn Fn(usize) -> f64) -> (Vec<(f64, f64)>, Vec<(f64, f64)>) {
+fn binned(c: &Chan, idx: &[usize], y: &dyn Fn(usize) -> f64) -> (Curve, Curve) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for &i in idx {
         let s = c.slip_deg(i);

@@ -90,7 +90,7 @@ pub fn run(a: Args) -> Result<()> {
             };
             let dropped = drop_unfitted(&mut recs, &fit);
             let mut note = format!(
-                "Baseline: steady MF 6.1 fitted to the recordings (every {}. sample; σ Fx {}, Fy {}, Mz {}), started from the built-in tyre with FNOMIN/NOMPRES/LONGVL from the data; held (so the candidates can name them): relaxation lengths, pressure terms {} (0, data pooled at the median pressure), LMUV and all scaling factors, BREFF/DREFF/FREFF.",
+                "Baseline: steady MF 6.1 fitted to the recordings (every {}. sample; σ Fx {}, Fy {}, Mz {}), started from the built-in tyre with FNOMIN/NOMPRES/LONGVL from the data; each channel diagnosed on the segment kinds it was fitted on (Mz on cornering only); held (so the candidates can name them): relaxation lengths, pressure terms {} (0, data pooled at the median pressure), LMUV and all scaling factors, BREFF/DREFF/FREFF.",
                 fit.stride,
                 sig("Fx"),
                 sig("Fy"),

@@ -38,9 +38,10 @@
 //! a recording without some channel (stages without data are skipped and
 //! reported).
 
-use crate::data::Recording;
+use crate::data::{Recording, SegmentKind};
 use crate::error::Result;
 use crate::fit::mf_fit::{fit_mf, MfFitOptions};
+use crate::fit::mf_stages::{Channel, StageKind};
 use crate::fit::{Holdout, ProgressFn};
 use crate::tir::TyreParams;
 
@@ -97,29 +98,59 @@ pub fn decimate(rec: &Recording, k: usize) -> Recording {
     out
 }
 
-/// Blank (NaN) the force channels among Fx, Fy, Mz the baseline fit did
-/// not fit (no segments of their kind, e.g. Fx of a lateral-only test, where
-/// Fx is rig crosstalk): the baseline knows nothing of them, so their
-/// residual would be the start tyre's, not a missing physics. Returns the
-/// channels blanked; the diagnosis then skips them (scores, locate, plots).
+/// Blank (NaN) each force channel among Fx, Fy, Mz on the segments of a
+/// kind the baseline fit did not fit it on, and drop a channel no stage fit
+/// at all (e.g. Fx of a lateral-only test, where Fx is rig crosstalk). The
+/// stages fit Fx on drive/brake and combined segments, Fy on cornering and
+/// combined ones, Mz on cornering ones only
+/// ([`StageKind::segments_and_channels`]): elsewhere the baseline's value is
+/// the start tyre's, not a fit (Mz under braking comes from SSZ*, which
+/// cornering data cannot determine), and its residual would be named as a
+/// missing physics. Returns the channels dropped entirely; the diagnosis
+/// skips blanked samples (scores, locate, plots).
 pub fn drop_unfitted(recs: &mut [Recording], b: &Baseline) -> Vec<&'static str> {
-    let fitted = |c: &str| b.report.metrics.iter().any(|m| m.channel == c);
-    let mut out = Vec::new();
-    for c in ["Fx", "Fy", "Mz"] {
-        if fitted(c) || !recs.iter().any(|r| r.has(c)) {
-            continue;
-        }
-        for r in recs.iter_mut() {
-            r.channels.retain(|x| !x.eq_ignore_ascii_case(c));
-            for s in &mut r.samples {
-                match c {
-                    "Fx" => s.fx = f64::NAN,
-                    "Fy" => s.fy = f64::NAN,
-                    _ => s.mz = f64::NAN,
-                }
+    let mut fitted: Vec<(Channel, SegmentKind)> = Vec::new();
+    for st in &b.report.stages {
+        for k in [
+            StageKind::PureFx,
+            StageKind::PureFy,
+            StageKind::Mz,
+            StageKind::Combined,
+        ] {
+            if k.name() == st.stage {
+                let (seg, chans) = k.segments_and_channels();
+                fitted.extend(chans.iter().map(|&c| (c, seg)));
             }
         }
-        out.push(c);
+    }
+    let mut out = Vec::new();
+    for c in [Channel::Fx, Channel::Fy, Channel::Mz] {
+        if !recs.iter().any(|r| r.has(c.name())) {
+            continue;
+        }
+        let blank = |s: &mut crate::data::Sample| match c {
+            Channel::Fx => s.fx = f64::NAN,
+            Channel::Fy => s.fy = f64::NAN,
+            _ => s.mz = f64::NAN,
+        };
+        let none = !fitted.iter().any(|f| f.0 == c);
+        for r in recs.iter_mut() {
+            let n = r.samples.len();
+            if none {
+                r.channels.retain(|x| !x.eq_ignore_ascii_case(c.name()));
+                r.samples.iter_mut().for_each(blank);
+                continue;
+            }
+            let segs = r.segments.clone();
+            for g in segs.iter().filter(|g| !fitted.contains(&(c, g.kind))) {
+                r.samples[g.start.min(n)..g.end.min(n)]
+                    .iter_mut()
+                    .for_each(blank);
+            }
+        }
+        if none {
+            out.push(c.name());
+        }
     }
     out
 }

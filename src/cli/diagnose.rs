@@ -1,17 +1,23 @@
-//! `tyrekit diagnose` — arguments and dispatch: replay, locate, evaluate the
-//! candidate extensions, write `DIR/diagnosis.json`, `DIR/baseline.tir` and
-//! `DIR/extended.tir` (see [`crate::diagnose::report`]).
+//! `tyrekit diagnose` — arguments and dispatch: the baseline (`--tir`, or the
+//! steady MF 6.1 fitted to the recordings with the candidates' parameters
+//! held, [`crate::diagnose::baseline`]), replay, locate, the candidate
+//! extensions, the verdict in words, and the report directory:
+//! `diagnosis.json`, `report.html` with its SVG plots, `baseline.tir`,
+//! `extended.tir` (see [`crate::diagnose::report`]). Progress bars on stderr
+//! when it is a terminal.
 //!
-//! Current state: the baseline must be given with `--tir` (fitting the
-//! baseline MF 6.1 from the recording is not wired yet); candidates `none`
-//! and `relaxation`; no HTML report or plots yet.
-//!
-//! Must never: panic on bad input (errors name the file or flag).
+//! Must never: panic on bad input (errors name the file or flag), or draw
+//! progress when stderr is not a terminal.
 
+use crate::diagnose::baseline::{drop_unfitted, fit_baseline, HELD_PRESSURE_KEYS};
 use crate::diagnose::replay::ReplayOptions;
-use crate::diagnose::report::{diagnose, merge};
+use crate::diagnose::report::{diagnose_with, merge};
+use crate::diagnose::{html, plots};
+use crate::fit::Progress;
 use crate::mf::Tyre;
 use crate::{Error, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
 use std::path::PathBuf;
 
 /// Arguments of `tyrekit diagnose`.
@@ -23,32 +29,132 @@ pub struct Args {
     /// Report directory (created).
     #[arg(long)]
     pub report: PathBuf,
-    /// Baseline tyre (.tir).
+    /// Baseline tyre (.tir). Default: fit the steady MF 6.1 to the recordings.
     #[arg(long)]
     pub tir: Option<PathBuf>,
 }
 
+fn bar(len: u64, template: &str) -> Option<ProgressBar> {
+    std::io::stderr().is_terminal().then(|| {
+        let b = ProgressBar::new(len);
+        b.set_style(
+            ProgressStyle::with_template(template).unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        b.enable_steady_tick(std::time::Duration::from_millis(200));
+        b
+    })
+}
+
 /// Run the command.
 pub fn run(a: Args) -> Result<()> {
-    let Some(tir) = &a.tir else {
-        return Err(Error::Input(
-            "diagnose: fitting the baseline from the recording is not wired yet; pass --tir base.tir".into(),
-        ));
-    };
-    let tyre = Tyre::from_file(tir)?;
-    let mut recs = Vec::new();
+    let t0 = std::time::Instant::now();
+    let mut recs: Vec<crate::data::Recording> = Vec::new();
     for p in &a.recordings {
         recs.push(crate::data::Recording::from_file(p)?);
     }
-    let rec = merge(recs);
+    if let Some(tir) = &a.tir {
+        if !tir.is_file() {
+            return Err(Error::Input(format!(
+                "--tir {}: no such file",
+                tir.display()
+            )));
+        }
+    }
     std::fs::create_dir_all(&a.report).map_err(|e| Error::io(&a.report, e))?;
-    let d = diagnose(&rec, &tyre, &ReplayOptions::default())?;
+    let (tyre, note) = match &a.tir {
+        Some(tir) => (
+            Tyre::from_file(tir)?,
+            format!("Baseline: {} (given with --tir).", tir.display()),
+        ),
+        None => {
+            let b = bar(100, "{prefix:>12} [{bar:30}] {pos}/{len} {msg}");
+            let mut cb = |p: &Progress| {
+                if let Some(b) = &b {
+                    b.set_prefix(format!("fit {}", p.stage));
+                    b.set_length(p.max_iterations as u64);
+                    b.set_position(p.iteration as u64);
+                    b.set_message(format!("cost {:.4e}", p.cost));
+                }
+            };
+            let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+            let fit = fit_baseline(&recs, threads, Some(&mut cb))?;
+            if let Some(b) = &b {
+                b.finish_and_clear();
+            }
+            for s in &fit.skipped {
+                eprintln!("tyrekit diagnose: baseline fit stage skipped: {s}");
+            }
+            let sig = |ch: &str| {
+                crate::fit::mf_fit::overall_sigma(&fit.report.metrics, ch)
+                    .map_or("–".into(), |v| format!("{:.1} %", 100.0 * v))
+            };
+            let dropped = drop_unfitted(&mut recs, &fit);
+            let mut note = format!(
+                "Baseline: steady MF 6.1 fitted to the recordings (every {}. sample; σ Fx {}, Fy {}, Mz {}), started from the built-in tyre with FNOMIN/NOMPRES/LONGVL from the data; each channel diagnosed on the segment kinds it was fitted on (Mz on cornering only); held (so the candidates can name them): relaxation lengths, pressure terms {} (0, data pooled at the median pressure), LMUV and all scaling factors, BREFF/DREFF/FREFF.",
+                fit.stride,
+                sig("Fx"),
+                sig("Fy"),
+                sig("Mz"),
+                HELD_PRESSURE_KEYS.join(" "),
+            );
+            if !dropped.is_empty() {
+                note.push_str(&format!(
+                    " Not diagnosed: {} (the data have no segments to fit {} on).",
+                    dropped.join(", "),
+                    if dropped.len() == 1 { "it" } else { "them" }
+                ));
+            }
+            (Tyre::new(fit.tyre)?, note)
+        }
+    };
+    println!("{note}");
+    let rec = merge(recs);
+    let steps = bar(3, "{prefix:>12} [{bar:30}] {pos}/{len} {msg} {elapsed}");
+    if let Some(b) = &steps {
+        b.set_prefix("diagnose");
+    }
+    let mut step = |s: &str| {
+        if let Some(b) = &steps {
+            if !b.message().is_empty() {
+                b.inc(1);
+            }
+            b.set_message(s.to_string());
+        }
+    };
+    let d = diagnose_with(&rec, &tyre, &ReplayOptions::default(), &mut step)?;
     tyre.params().write(&a.report.join("baseline.tir"))?;
     d.extended.params().write(&a.report.join("extended.tir"))?;
+    let pl = plots::draw_all(&rec, &d, &a.report)?;
+    if let Some(b) = &steps {
+        b.finish_and_clear();
+    }
+    let mut json = d.json.clone();
+    json["baseline"] = serde_json::json!(note);
+    json["plots"] = serde_json::to_value(&pl).unwrap_or_default();
     let jp = a.report.join("diagnosis.json");
-    let text = serde_json::to_string_pretty(&d.json)
+    let text = serde_json::to_string_pretty(&json)
         .map_err(|e| Error::Other(format!("diagnosis.json: {e}")))?;
     std::fs::write(&jp, text).map_err(|e| Error::io(&jp, e))?;
-    println!("verdict: {} ({})", d.verdict, jp.display());
+    let hp = a.report.join("report.html");
+    std::fs::write(&hp, html::page(&d, &pl, &rec.source, &note)).map_err(|e| Error::io(&hp, e))?;
+    println!("verdict: {}", d.verdict);
+    println!("{}", d.explanation);
+    for r in d.out_of_sample.iter().filter(|r| r.condition == "all") {
+        println!(
+            "  held out {}: σ {:.2} % -> {:.2} %, NRMSE {:.2} % -> {:.2} %",
+            crate::diagnose::report::pretty(r.channel),
+            100.0 * r.sigma_before,
+            100.0 * r.sigma_after,
+            100.0 * r.nrmse_before,
+            100.0 * r.nrmse_after
+        );
+    }
+    println!(
+        "wrote {} ({} plots), {}, baseline.tir, extended.tir in {:.1} s",
+        hp.display(),
+        pl.len(),
+        jp.display(),
+        t0.elapsed().as_secs_f64()
+    );
     Ok(())
 }

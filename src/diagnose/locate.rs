@@ -13,7 +13,8 @@
 //!   the accumulated frictional energy at the segment's middle). Null: the
 //!   segment values exchanged among segments (permutation test).
 //!
-//! Sample level (within segments; residuals demeaned per segment):
+//! Sample level (within segments; residuals demeaned per segment; at most
+//! [`MAX_WITHIN`] samples, longer recordings thinned by a constant stride):
 //! * `slip_region` — between-region share (R²) of `u = r·sign(F_sim)`
 //!   ("measured stronger than the model") over the linear
 //!   (|K·s|/F_peak < 0.8), peak and sliding (|s| beyond 1.15 × the slip of
@@ -99,6 +100,12 @@ pub struct Finding {
     pub significant: bool,
     /// Plain-words detail (group means, hysteresis amplitude …).
     pub detail: String,
+    /// The same figures by name, for the explanation: segment groupings
+    /// `x_min`, `x_max` (set points) and `scale_at_min`, `scale_at_max`
+    /// (relative force scale errors there); `slip_region` the mean signed
+    /// residual per region `linear`, `peak`, `sliding` (channel unit);
+    /// `sweep_direction` the paired `rising_minus_falling` residual.
+    pub groups: Vec<(String, f64)>,
 }
 
 impl Finding {
@@ -113,7 +120,22 @@ impl Finding {
             p_adjusted: p,
             significant: false,
             detail,
+            groups: Vec::new(),
         }
+    }
+
+    /// With named figures (see [`Finding::groups`]).
+    fn with_groups(mut self, g: &[(&str, f64)]) -> Finding {
+        self.groups = g.iter().map(|(k, v)| (k.to_string(), *v)).collect();
+        self
+    }
+
+    /// A named figure of [`Finding::groups`] (NaN when absent).
+    pub fn group(&self, key: &str) -> f64 {
+        self.groups
+            .iter()
+            .find(|(k, _)| k == key)
+            .map_or(f64::NAN, |g| g.1)
     }
 }
 
@@ -158,6 +180,26 @@ fn r2(x: &[f64], y: &[f64]) -> f64 {
     }
 }
 
+/// Least-squares slope of y on x (0 when x is constant).
+fn slope(x: &[f64], y: &[f64]) -> f64 {
+    let n = x.len().min(y.len()) as f64;
+    if n < 2.0 {
+        return 0.0;
+    }
+    let mx = x.iter().sum::<f64>() / n;
+    let my = y.iter().sum::<f64>() / n;
+    let (mut sxy, mut sxx) = (0.0, 0.0);
+    for (a, b) in x.iter().zip(y) {
+        sxy += (a - mx) * (b - my);
+        sxx += (a - mx) * (a - mx);
+    }
+    if sxx > 0.0 {
+        sxy / sxx
+    } else {
+        0.0
+    }
+}
+
 /// Observed value and null distribution → (z, p).
 fn significance(obs: f64, null: &[f64]) -> (f64, f64) {
     let n = null.len() as f64;
@@ -191,6 +233,13 @@ fn segment_values(d: &Residuals) -> Vec<(usize, f64, f64)> {
     v
 }
 
+/// Most samples the sample-level tests use: longer recordings are thinned by
+/// a constant stride (each test costs `permutations` passes over them). A
+/// circular shift keeps the thinned series' autocorrelation as it keeps the
+/// full one's, so the null stays right; rig channels at 100 Hz and more are
+/// smooth over many samples, so little information is lost.
+pub const MAX_WITHIN: usize = 30_000;
+
 /// Sample-level working arrays (within segments, finite samples only).
 struct Within {
     /// Segment ranges into the arrays below.
@@ -219,8 +268,11 @@ fn within(d: &Residuals) -> Within {
         region: vec![],
         slip: vec![],
     };
+    let total: usize = d.segments.iter().map(|g| g.len()).sum();
+    let stride = total.div_ceil(MAX_WITHIN).max(1);
     for g in d.segments {
         let idx: Vec<usize> = (g.start..g.end.min(d.r.len()))
+            .step_by(stride)
             .filter(|&i| d.r[i].is_finite() && d.sim[i].is_finite() && d.slip[i].is_finite())
             .collect();
         if idx.len() < 10 {
@@ -397,19 +449,27 @@ pub fn locate(d: &Residuals, o: &LocateOptions) -> Vec<Finding> {
             })
             .collect();
         let (lo, hi) = extremes(&x, &b);
-        out.push(Finding::new(
-            name,
-            obs,
-            &null,
-            format!(
-                "relative force scale error {:+.2} % at {name} {:.4}, {:+.2} % at {:.4} ({} segments)",
-                100.0 * lo.1,
-                lo.0,
-                100.0 * hi.1,
-                hi.0,
-                x.len()
-            ),
-        ));
+        out.push(
+            Finding::new(
+                name,
+                obs,
+                &null,
+                format!(
+                    "relative force scale error {:+.2} % at {name} {:.4}, {:+.2} % at {:.4} ({} segments)",
+                    100.0 * lo.1,
+                    lo.0,
+                    100.0 * hi.1,
+                    hi.0,
+                    x.len()
+                ),
+            )
+            .with_groups(&[
+                ("x_min", lo.0),
+                ("x_max", hi.0),
+                ("scale_at_min", lo.1),
+                ("scale_at_max", hi.1),
+            ]),
+        );
     }
 
     // Sample level.
@@ -446,6 +506,8 @@ pub fn locate(d: &Residuals, o: &LocateOptions) -> Vec<Finding> {
                 })
                 .collect::<Vec<_>>()
         };
+        let hyst = hysteresis(&w);
+        let drift = slope(&w.time, &w.u);
         sample_test(
             "slip_region",
             &w.u,
@@ -461,10 +523,7 @@ pub fn locate(d: &Residuals, o: &LocateOptions) -> Vec<Finding> {
                 "sweep_direction",
                 &w.r,
                 &|y| r2(y, &w.dir),
-                format!(
-                    "rising − falling residual at equal slip: {:+.3} (paired, slip bins)",
-                    hysteresis(&w)
-                ),
+                format!("rising − falling residual at equal slip: {hyst:+.3} (paired, slip bins)"),
                 &mut rng,
             );
         }
@@ -482,6 +541,20 @@ pub fn locate(d: &Residuals, o: &LocateOptions) -> Vec<Finding> {
             "signed residual against time since the run began (drift)".into(),
             &mut rng,
         );
+        for f in out.iter_mut() {
+            match f.name {
+                "slip_region" => {
+                    f.groups = ["linear", "peak", "sliding"]
+                        .iter()
+                        .zip(&region_means)
+                        .map(|(k, v)| (k.to_string(), *v))
+                        .collect()
+                }
+                "sweep_direction" => f.groups = vec![("rising_minus_falling".into(), hyst)],
+                "time_in_run" => f.groups = vec![("slope_per_s".into(), drift)],
+                _ => {}
+            }
+        }
     }
 
     // Holm step-down adjustment.

@@ -1,31 +1,62 @@
 //! report — the `diagnose` pipeline end to end for one (merged) recording:
 //! replay the baseline, locate the residual structure per channel, evaluate
-//! the candidates, choose the verdict, and build `diagnosis.json`.
+//! the candidates, choose the verdict, explain it in words, score the fit
+//! before and after per channel and condition (in-sample and held out), and
+//! build `diagnosis.json`.
 //!
-//! Verdict rule: the candidate with the largest out-of-sample gain, if that
-//! gain exceeds [`MIN_GAIN`] and its BIC falls; otherwise `none`.
+//! # Quality figures
+//! σ = √(Σ(sim − test)² / Σ test²) and NRMSE = RMS(sim − test) / range(test)
+//! ([`crate::fit::metrics`]) of the baseline ("before") and of the verdict's
+//! extended model ("after"), per channel (FX, FY, MZ), over all samples and
+//! per condition (load, inclination, pressure; and per speed when the
+//! recording has more than one), on the segments the candidates were fitted
+//! on (`in_sample`) and on those they never saw (`out_of_sample`) — the
+//! split of [`super::candidate::split`]. These are the raw residuals (no
+//! offsets removed), as a user would compute them from `replay`.
 //!
-//! Must never: name an effect whose held-out improvement is within noise.
+//! # Explanation
+//! The significant [`locate`] findings of each channel are put in words
+//! ("the FY residual changes with the sweep direction (rising − falling
+//! +41 N) and follows the force rate"), then the verdict's physics and its
+//! fitted parameters in words ([`Evaluation::physics`], [`Evaluation::describe`])
+//! and the share of the held-out error it removes. For `none` the text
+//! says whether the residual showed structure at all and what the best
+//! candidate achieved.
+//!
+//! Must never: name an effect whose held-out improvement is within noise
+//! (the selection rule decides), or call a grouping significant that
+//! [`locate`] did not.
 
-use super::candidate::{all, evaluate, Candidate, CHANNELS};
+use super::candidate::{all, evaluate, select, Candidate, Evaluation, CHANNELS};
 use super::locate::{frictional_energy, locate, Finding, LocateOptions, Residuals};
 use super::replay::{replay, ReplayOptions};
 use crate::data::Recording;
 use crate::error::Result;
-use crate::fit::metrics::nrmse;
+use crate::fit::metrics::{self, nrmse, sigma};
 use crate::mf::{Forces, Tyre};
 use serde_json::{json, Map, Value};
+use std::ops::Range;
 
-/// Smallest held-out gain (share of the baseline's held-out SSE removed)
-/// that names an effect.
-pub const MIN_GAIN: f64 = 0.05;
+/// Smallest held-out gain that names an effect (the rule: [`super::candidate::select`]).
+pub use super::candidate::MIN_GAIN;
 
-/// NRMSE per channel (FX, FY, MZ) of `sim` against the recording.
-pub fn nrmse_map(rec: &Recording, sim: &[Forces]) -> Value {
+/// The channels the report scores and plots: (name, unit).
+pub const REPORT_CHANNELS: [(&str, &str); 3] = [("FX", "N"), ("FY", "N"), ("MZ", "N m")];
+
+/// NRMSE per channel (FX, FY, MZ) of `sim` against the recording, over the
+/// samples where `mask` is true (`None`: all).
+pub fn nrmse_map(rec: &Recording, sim: &[Forces], mask: Option<&[bool]>) -> Value {
     let mut m = Map::new();
     for (name, fs, fm) in CHANNELS {
-        let y: Vec<f64> = rec.samples.iter().map(fm).collect();
-        let p: Vec<f64> = sim.iter().map(fs).collect();
+        let on = |i: usize| mask.is_none_or(|k| k.get(i).copied().unwrap_or(false));
+        let (y, p): (Vec<f64>, Vec<f64>) = rec
+            .samples
+            .iter()
+            .zip(sim)
+            .enumerate()
+            .filter(|(i, _)| on(*i))
+            .map(|(_, (s, f))| (fm(s), fs(f)))
+            .unzip();
         let v = nrmse(&p, &y);
         m.insert(
             name.into(),
@@ -35,6 +66,42 @@ pub fn nrmse_map(rec: &Recording, sim: &[Forces]) -> Value {
     Value::Object(m)
 }
 
+/// (measured, simulated, driving slip) of one channel.
+pub fn channel_series(
+    rec: &Recording,
+    sim: &[Forces],
+    channel: &str,
+) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let s = &rec.samples;
+    match channel {
+        "FX" => (
+            s.iter().map(|s| s.fx).collect(),
+            sim.iter().map(|f| f.fx).collect(),
+            s.iter().map(|s| s.kappa).collect(),
+        ),
+        "MZ" => (
+            s.iter().map(|s| s.mz).collect(),
+            sim.iter().map(|f| f.mz).collect(),
+            s.iter().map(|s| s.alpha).collect(),
+        ),
+        _ => (
+            s.iter().map(|s| s.fy).collect(),
+            sim.iter().map(|f| f.fy).collect(),
+            s.iter().map(|s| s.alpha).collect(),
+        ),
+    }
+}
+
+/// Whether the recording carries `channel` (FX/FY/MZ) with some variation.
+pub fn channel_present(rec: &Recording, channel: &str) -> bool {
+    let name = match channel {
+        "FX" => "Fx",
+        "MZ" => "Mz",
+        _ => "Fy",
+    };
+    rec.has(name)
+}
+
 /// Locate findings of one channel.
 pub fn locate_channel(
     rec: &Recording,
@@ -42,23 +109,7 @@ pub fn locate_channel(
     energy: &[f64],
     channel: &str,
 ) -> Vec<Finding> {
-    let (meas, simc, slip): (Vec<f64>, Vec<f64>, Vec<f64>) = match channel {
-        "FX" => (
-            rec.samples.iter().map(|s| s.fx).collect(),
-            sim.iter().map(|f| f.fx).collect(),
-            rec.samples.iter().map(|s| s.kappa).collect(),
-        ),
-        "MZ" => (
-            rec.samples.iter().map(|s| s.mz).collect(),
-            sim.iter().map(|f| f.mz).collect(),
-            rec.samples.iter().map(|s| s.alpha).collect(),
-        ),
-        _ => (
-            rec.samples.iter().map(|s| s.fy).collect(),
-            sim.iter().map(|f| f.fy).collect(),
-            rec.samples.iter().map(|s| s.alpha).collect(),
-        ),
-    };
+    let (meas, simc, slip) = channel_series(rec, sim, channel);
     let r: Vec<f64> = meas.iter().zip(&simc).map(|(m, s)| m - s).collect();
     let d = Residuals {
         r: &r,
@@ -72,36 +123,434 @@ pub fn locate_channel(
     locate(&d, &LocateOptions::default())
 }
 
-/// The diagnosis and the chosen extended tyre.
+/// The candidates' split ([`super::candidate::split`]) as sample ranges:
+/// (fit half, held-out half).
+pub fn split(rec: &Recording) -> (Vec<Range<usize>>, Vec<Range<usize>>) {
+    let (fit, test) = super::candidate::split(rec);
+    (ranges(&fit), ranges(&test))
+}
+
+/// The runs of `true` in `mask` as half-open ranges.
+fn ranges(mask: &[bool]) -> Vec<Range<usize>> {
+    let mut out = Vec::new();
+    let mut start = None;
+    for (i, &m) in mask.iter().chain(std::iter::once(&false)).enumerate() {
+        match (m, start) {
+            (true, None) => start = Some(i),
+            (false, Some(a)) => {
+                out.push(a..i);
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    out
+}
+
+/// One row of the quality table.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct QualityRow {
+    pub channel: &'static str,
+    /// "all", "Fz 4000 N, γ 0.0°, p 220 kPa" or "Vx 16.2 m/s".
+    pub condition: String,
+    pub n: usize,
+    pub sigma_before: f64,
+    pub sigma_after: f64,
+    pub nrmse_before: f64,
+    pub nrmse_after: f64,
+}
+
+/// `sim` plus its constant offset from the measurement, estimated as the
+/// mean of (measured − sim) over `fit` (the fit half only, so the held-out
+/// half stays unseen).
+fn with_offset(y: &[f64], sim: &[f64], fit: &[Range<usize>]) -> Vec<f64> {
+    let (mut s, mut n) = (0.0, 0.0);
+    for r in fit {
+        for i in r.clone() {
+            let d = y[i] - sim[i];
+            if d.is_finite() {
+                s += d;
+                n += 1.0;
+            }
+        }
+    }
+    let o = if n > 0.0 { s / n } else { 0.0 };
+    sim.iter().map(|v| v + o).collect()
+}
+
+/// Before/after σ and NRMSE per channel and condition over `ranges`. Each
+/// model's constant channel offset (a sensor zero, not physics — the
+/// scoring of the candidates treats it so too) is estimated on the fit
+/// half `fit` and removed first.
+pub fn quality(
+    rec: &Recording,
+    before: &[Forces],
+    after: &[Forces],
+    fit: &[Range<usize>],
+    ranges: &[Range<usize>],
+) -> Result<Vec<QualityRow>> {
+    let mut rows = Vec::new();
+    for (ch, _) in REPORT_CHANNELS {
+        if !channel_present(rec, ch) {
+            continue;
+        }
+        let name = match ch {
+            "FX" => "Fx",
+            "MZ" => "Mz",
+            _ => "Fy",
+        };
+        let (_, sb, _) = channel_series(rec, before, ch);
+        let (y, sa, _) = channel_series(rec, after, ch);
+        let (sb, sa) = (with_offset(&y, &sb, fit), with_offset(&y, &sa, fit));
+        let mb = metrics::evaluate(rec, name, &sb, Some(ranges))?;
+        let ma = metrics::evaluate(rec, name, &sa, Some(ranges))?;
+        for (b, a) in mb.iter().zip(&ma) {
+            rows.push(QualityRow {
+                channel: ch,
+                condition: b.condition.as_ref().map_or("all".into(), |c| {
+                    format!(
+                        "Fz {:.0} N, γ {:.1}°, p {:.0} kPa",
+                        c.fz,
+                        c.gamma.to_degrees(),
+                        c.p / 1e3
+                    )
+                }),
+                n: b.n,
+                sigma_before: b.sigma,
+                sigma_after: a.sigma,
+                nrmse_before: b.nrmse,
+                nrmse_after: a.nrmse,
+            });
+        }
+        // Per speed, when the programme has more than one.
+        let mut speeds: Vec<f64> = rec
+            .segments
+            .iter()
+            .map(|g| (g.vx * 10.0).round() / 10.0)
+            .filter(|v| v.is_finite())
+            .collect();
+        speeds.sort_by(f64::total_cmp);
+        speeds.dedup();
+        if speeds.len() > 1 {
+            for v in speeds {
+                let (mut yy, mut pb, mut pa) = (Vec::new(), Vec::new(), Vec::new());
+                for g in rec
+                    .segments
+                    .iter()
+                    .filter(|g| (g.vx * 10.0).round() / 10.0 == v)
+                {
+                    for r in ranges {
+                        for i in g.start.max(r.start)..g.end.min(r.end).min(y.len()) {
+                            yy.push(y[i]);
+                            pb.push(sb[i]);
+                            pa.push(sa[i]);
+                        }
+                    }
+                }
+                if !yy.is_empty() {
+                    rows.push(QualityRow {
+                        channel: ch,
+                        condition: format!("Vx {v:.1} m/s"),
+                        n: yy.iter().filter(|x| x.is_finite()).count(),
+                        sigma_before: sigma(&pb, &yy),
+                        sigma_after: sigma(&pa, &yy),
+                        nrmse_before: nrmse(&pb, &yy),
+                        nrmse_after: nrmse(&pa, &yy),
+                    });
+                }
+            }
+        }
+    }
+    Ok(rows)
+}
+
+/// The significant findings of one channel in words ("changes with the
+/// sweep direction (rising − falling +41 N) and follows the force rate"),
+/// or None when nothing is significant. At most the three strongest (by z;
+/// [`locate`] ranks them) are named.
+pub fn findings_in_words(findings: &[Finding], unit: &str) -> Option<String> {
+    let parts: Vec<String> = findings
+        .iter()
+        .filter(|f| f.significant)
+        .take(3)
+        .map(|f| {
+            let scale = |what: &str| {
+                format!(
+                    "scales with {what} (force scale error {:+.1} % at {}, {:+.1} % at {})",
+                    100.0 * f.group("scale_at_min"),
+                    set_point(f.name, f.group("x_min")),
+                    100.0 * f.group("scale_at_max"),
+                    set_point(f.name, f.group("x_max"))
+                )
+            };
+            match f.name {
+                "sweep_direction" => format!(
+                    "changes with the sweep direction (rising − falling {} {unit} at equal slip)",
+                    sig3(f.group("rising_minus_falling"), true)
+                ),
+                "force_rate" => "follows the force rate (it grows with the slip rate)".into(),
+                "time_in_run" => format!(
+                    "drifts with time in the run ({} {unit}/s, + = measured getting stronger)",
+                    sig3(f.group("slope_per_s"), true)
+                ),
+                "slip_region" => {
+                    let regions = ["linear", "peak", "sliding"];
+                    let (k, v) = regions
+                        .iter()
+                        .map(|r| (*r, f.group(r)))
+                        .filter(|x| x.1.is_finite())
+                        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+                        .unwrap_or(("linear", 0.0));
+                    format!(
+                        "concentrates in the {k} slip region (measured {} than the model by {} {unit} on average)",
+                        if v >= 0.0 { "stronger" } else { "weaker" },
+                        sig3(v.abs(), false)
+                    )
+                }
+                "load" => scale("load"),
+                "inclination" => scale("inclination"),
+                "pressure" => scale("pressure"),
+                "speed" => scale("speed"),
+                "energy" => scale("the accumulated frictional energy"),
+                other => format!("depends on {other}"),
+            }
+        })
+        .collect();
+    match parts.len() {
+        0 => None,
+        1 => Some(parts[0].clone()),
+        n => Some(format!(
+            "{} and {}",
+            parts[..n - 1].join(", "),
+            parts[n - 1]
+        )),
+    }
+}
+
+/// `x` to 3 significant digits (with its sign when `signed`).
+fn sig3(x: f64, signed: bool) -> String {
+    let d = if x == 0.0 || !x.is_finite() {
+        0
+    } else {
+        (2 - x.abs().log10().floor() as i32).clamp(0, 6) as usize
+    };
+    if signed {
+        format!("{x:+.d$}")
+    } else {
+        format!("{x:.d$}")
+    }
+}
+
+/// A set point in engineering units.
+fn set_point(grouping: &str, x: f64) -> String {
+    match grouping {
+        "load" => format!("{x:.0} N"),
+        "inclination" => format!("{:.1}°", x.to_degrees()),
+        "pressure" => format!("{:.0} kPa", x / 1e3),
+        "speed" => format!("{x:.1} m/s"),
+        "energy" => format!("{:.0} kJ", x / 1e3),
+        _ => format!("{x:.4}"),
+    }
+}
+
+/// The explanation of the verdict (see the module docs).
+pub fn explain(
+    findings: &[(&'static str, Vec<Finding>)],
+    verdict: Option<&Evaluation>,
+    best_other: Option<&Evaluation>,
+    alpha: f64,
+) -> String {
+    let mut where_ = Vec::new();
+    for (ch, f) in findings {
+        let unit = REPORT_CHANNELS
+            .iter()
+            .find(|c| c.0 == *ch)
+            .map_or("", |c| c.1);
+        if let Some(w) = findings_in_words(f, unit) {
+            where_.push(format!("the {} residual {w}", pretty(ch)));
+        }
+    }
+    let located = if where_.is_empty() {
+        None
+    } else {
+        Some(where_.join("; "))
+    };
+    match verdict {
+        Some(e) => format!(
+            "{}. Missing from the model: {}. {} removes {:.0} % of the baseline's error on held-out segments (BIC {:+.1}).",
+            capitalise(located.as_deref().unwrap_or(
+                "no single grouping of the residual is significant on its own"
+            )),
+            e.physics,
+            capitalise(&e.describe),
+            100.0 * e.oos_gain,
+            e.delta_bic
+        ),
+        None => {
+            let best = best_other.map_or("no candidate was evaluated".to_string(), |b| {
+                format!(
+                    "the best candidate, {}, removes {:.1} % of the held-out error (BIC {:+.1}; naming an effect needs more than {:.0} % and a falling BIC)",
+                    b.name,
+                    100.0 * b.oos_gain,
+                    b.delta_bic,
+                    100.0 * MIN_GAIN
+                )
+            });
+            match located {
+                None => format!(
+                    "Nothing is missing: the residual is noise (no grouping significant at {:.0} % family-wise) and {best}.",
+                    100.0 * alpha
+                ),
+                Some(w) => format!(
+                    "{}, but none of the candidates explains it: {best}. The structure is real but lies outside the candidate physics (or in the baseline's own fit).",
+                    capitalise(&w)
+                ),
+            }
+        }
+    }
+}
+
+/// Relative rise of a channel's held-out σ above which the verdict's
+/// explanation carries a caution (10 %: well above the run-to-run scatter
+/// of σ between the halves, far below what a real improvement shows).
+pub const WORSE: f64 = 0.10;
+
+/// A caution when the verdict's model makes a channel's held-out fit worse
+/// by more than [`WORSE`] (relative σ) while others gain: a tyre engineer
+/// would then suspect the gain comes from another misfit of the baseline
+/// that the extension happens to absorb, not from the named physics.
+pub fn caution(out_of_sample: &[QualityRow]) -> Option<String> {
+    let all: Vec<&QualityRow> = out_of_sample
+        .iter()
+        .filter(|r| r.condition == "all" && r.sigma_before.is_finite() && r.sigma_after.is_finite())
+        .collect();
+    let worse: Vec<String> = all
+        .iter()
+        .filter(|r| r.sigma_after > (1.0 + WORSE) * r.sigma_before)
+        .map(|r| {
+            format!(
+                "{} (held-out σ {:.2} % → {:.2} %)",
+                pretty(r.channel),
+                100.0 * r.sigma_before,
+                100.0 * r.sigma_after
+            )
+        })
+        .collect();
+    if worse.is_empty() {
+        return None;
+    }
+    let better: Vec<&str> = all
+        .iter()
+        .filter(|r| r.sigma_after < r.sigma_before)
+        .map(|r| pretty(r.channel))
+        .collect();
+    Some(format!(
+        "Caution: it makes {} worse{}; the verdict is doubtful — the gain may be another misfit of the baseline that this extension absorbs.",
+        worse.join(" and "),
+        if better.is_empty() {
+            String::new()
+        } else {
+            format!(", the gain comes from {} alone", better.join(" and "))
+        }
+    ))
+}
+
+/// The channel's name as engineers write it (FX → Fx).
+pub fn pretty(ch: &str) -> &'static str {
+    match ch {
+        "FX" => "Fx",
+        "MZ" => "Mz",
+        _ => "Fy",
+    }
+}
+
+fn capitalise(s: &str) -> String {
+    let mut c = s.chars();
+    c.next().map_or(String::new(), |f| {
+        f.to_uppercase().collect::<String>() + c.as_str()
+    })
+}
+
+/// The diagnosis: its JSON, the chosen extended tyre and the series the
+/// plots need.
 pub struct Diagnosis {
     pub json: Value,
     pub verdict: String,
+    pub explanation: String,
     pub extended: Tyre,
+    /// Baseline and verdict's simulation, one per sample.
+    pub baseline_sim: Vec<Forces>,
+    pub extended_sim: Vec<Forces>,
+    /// Findings per channel (FY, FX, MZ where present).
+    pub findings: Vec<(&'static str, Vec<Finding>)>,
+    /// Accumulated frictional energy per sample (J).
+    pub energy: Vec<f64>,
+    /// The quality rows: in-sample, out-of-sample.
+    pub in_sample: Vec<QualityRow>,
+    pub out_of_sample: Vec<QualityRow>,
 }
 
 /// Run the diagnosis of `rec` against the baseline `tyre`.
 pub fn diagnose(rec: &Recording, tyre: &Tyre, opts: &ReplayOptions) -> Result<Diagnosis> {
+    diagnose_with(rec, tyre, opts, &mut |_| {})
+}
+
+/// [`diagnose`], reporting each step's name to `step` before it runs.
+pub fn diagnose_with(
+    rec: &Recording,
+    tyre: &Tyre,
+    opts: &ReplayOptions,
+    step: &mut dyn FnMut(&str),
+) -> Result<Diagnosis> {
+    step("replay baseline");
     let base = replay(rec, tyre, opts)?;
     let energy = frictional_energy(rec);
-    let mut loc = Map::new();
-    for ch in ["FY", "FX", "MZ"] {
-        let f = locate_channel(rec, &base.sim, &energy, ch);
-        loc.insert(ch.into(), serde_json::to_value(&f).unwrap_or(Value::Null));
-    }
+    let channels: Vec<&'static str> = ["FY", "FX", "MZ"]
+        .into_iter()
+        .filter(|c| channel_present(rec, c))
+        .collect();
+    step("locate + candidates");
     let owned = all();
     let cands: Vec<&dyn Candidate> = owned.iter().map(|c| c.as_ref()).collect();
-    let ev = evaluate(rec, tyre, opts, &cands)?;
-    let before = nrmse_map(rec, &base.sim);
-    let best = ev
-        .iter()
-        .find(|(e, _)| e.name != "none" && e.oos_gain > MIN_GAIN && e.delta_bic < 0.0);
-    let verdict = best.map_or("none".to_string(), |(e, _)| e.name.clone());
+    // Locate (permutation tests) on a second thread while the candidates fit.
+    let (findings, ev) = std::thread::scope(|s| {
+        let h = s.spawn(|| {
+            channels
+                .iter()
+                .map(|&ch| (ch, locate_channel(rec, &base.sim, &energy, ch)))
+                .collect::<Vec<_>>()
+        });
+        let ev = evaluate(rec, tyre, opts, &cands);
+        (h.join(), ev)
+    });
+    let findings =
+        findings.map_err(|_| crate::Error::Other("diagnose: the locate thread failed".into()))?;
+    let ev = ev?;
+    step("report");
+    let verdict_i = select(&ev);
+    let verdict = verdict_i.map_or("none".to_string(), |i| ev[i].0.name.clone());
+    let (fit_r, test_r) = split(rec);
+    let mask = |rs: &[Range<usize>]| {
+        let mut m = vec![false; rec.samples.len()];
+        for r in rs {
+            m[r.clone()].iter_mut().for_each(|x| *x = true);
+        }
+        m
+    };
+    let test_mask = mask(&test_r);
     let mut effects = Vec::new();
     let mut order: Vec<usize> = (0..ev.len()).collect();
-    order.sort_by_key(|&i| if ev[i].0.name == verdict { 0 } else { 1 });
+    order.sort_by_key(|&i| usize::from(ev[i].0.name != verdict));
+    let before = nrmse_map(rec, &base.sim, None);
+    let before_oos = nrmse_map(rec, &base.sim, Some(&test_mask));
+    let mut extended_sim = base.sim.clone();
     for i in order {
         let (e, fitted) = &ev[i];
-        let sim = fitted.predict(rec)?;
+        let sim = if e.name == "none" {
+            base.sim.clone()
+        } else {
+            fitted.predict(rec)?
+        };
         let params: Map<String, Value> = e
             .parameters
             .iter()
@@ -111,19 +560,53 @@ pub fn diagnose(rec: &Recording, tyre: &Tyre, opts: &ReplayOptions) -> Result<Di
             "name": e.name,
             "score": e.oos_gain,
             "delta_bic": e.delta_bic,
+            "n_params": e.n_params,
             "evidence": format!(
-                "fitted on even segments, scored on odd ones: removes {:.1} % of the baseline's held-out squared error (BIC change {:+.1})",
-                100.0 * e.oos_gain, e.delta_bic
+                "{}fitted on one half of the segments, scored on the other: removes {:.1} % of the baseline's held-out squared error (BIC change {:+.1})",
+                if e.name == "none" {
+                    String::new()
+                } else {
+                    format!("{}: {}; ", e.physics, e.describe)
+                },
+                100.0 * e.oos_gain,
+                e.delta_bic
             ),
             "parameters": params,
             "nrmse_before": before,
-            "nrmse_after": nrmse_map(rec, &sim),
+            "nrmse_after": nrmse_map(rec, &sim, None),
+            "nrmse_before_held_out": before_oos,
+            "nrmse_after_held_out": nrmse_map(rec, &sim, Some(&test_mask)),
         }));
+        if Some(i) == verdict_i {
+            extended_sim = sim;
+        }
     }
-    let extended = best.map_or_else(|| tyre.clone(), |(_, f)| f.tyre().clone());
+    let best_other = ev.iter().find(|(e, _)| e.name != "none").map(|(e, _)| e);
+    let alpha = LocateOptions::default().alpha;
+    let in_sample = quality(rec, &base.sim, &extended_sim, &fit_r, &fit_r)?;
+    let out_of_sample = quality(rec, &base.sim, &extended_sim, &fit_r, &test_r)?;
+    let mut explanation = explain(&findings, verdict_i.map(|i| &ev[i].0), best_other, alpha);
+    if verdict_i.is_some() {
+        if let Some(c) = caution(&out_of_sample) {
+            explanation.push(' ');
+            explanation.push_str(&c);
+        }
+    }
+    let mut loc = Map::new();
+    for (ch, f) in &findings {
+        loc.insert((*ch).into(), serde_json::to_value(f).unwrap_or(Value::Null));
+    }
+    let extended = verdict_i.map_or_else(|| tyre.clone(), |i| ev[i].1.tyre().clone());
     let json = json!({
         "verdict": verdict,
+        "explanation": explanation,
         "effects": effects,
+        "quality": {
+            "model_after": verdict,
+            "split": "candidates fitted on one half of the segments (in_sample), scored on the other (out_of_sample); halves alternate within each (kind, load) group",
+            "in_sample": in_sample,
+            "out_of_sample": out_of_sample,
+        },
         "locate": loc,
         "candidates_implemented": owned.iter().map(|c| c.name()).collect::<Vec<_>>(),
         "samples": rec.samples.len(),
@@ -132,7 +615,14 @@ pub fn diagnose(rec: &Recording, tyre: &Tyre, opts: &ReplayOptions) -> Result<Di
     Ok(Diagnosis {
         json,
         verdict,
+        explanation,
         extended,
+        baseline_sim: base.sim,
+        extended_sim,
+        findings,
+        energy,
+        in_sample,
+        out_of_sample,
     })
 }
 

@@ -248,6 +248,8 @@ pub struct SlipProps {
 pub struct Tyre {
     params: TyreParams,
     model: Model<f64>,
+    /// Physics beyond the MF read from the file (see `transient::extension`).
+    ext: Option<crate::transient::extension::Extension>,
 }
 
 /// The equation family for a file version.
@@ -277,7 +279,8 @@ impl Tyre {
             }
         }
         let model = Model::new(params.p.clone(), form_of(params.version));
-        Ok(Tyre { params, model })
+        let ext = crate::transient::extension::Extension::from_params(&params)?;
+        Ok(Tyre { params, model, ext })
     }
     /// Load a `.tir` file and prepare it.
     pub fn from_file(path: &std::path::Path) -> crate::Result<Tyre> {
@@ -287,11 +290,20 @@ impl Tyre {
     pub fn builtin() -> Tyre {
         let params = TyreParams::builtin();
         let model = Model::new(params.p.clone(), form_of(params.version));
-        Tyre { params, model }
+        Tyre {
+            params,
+            model,
+            ext: None,
+        }
     }
     /// The parameters this tyre was built from.
     pub fn params(&self) -> &TyreParams {
         &self.params
+    }
+    /// The extension physics of the file (`[THERMAL]`, `[LOAD_SENSITIVITY]`,
+    /// LMUV), applied by the transient step; None for a plain MF file.
+    pub fn extension(&self) -> Option<&crate::transient::extension::Extension> {
+        self.ext.as_ref()
     }
     /// Equation set in use.
     pub fn version(&self) -> MfVersion {

@@ -122,26 +122,63 @@ impl TruthModel for Relaxation {
 
 /// LuGre dynamic friction (bristle hysteresis): this project's transient
 /// LuGre model (Canudas de Wit et al. 2003, average lumped) driven with the
-/// rig's prescribed slips. It has no strength yet: [`concealed`] ignores
-/// the level for it (default LuGre parameters derived from the MF).
+/// rig's prescribed slips. Strength `level`: bristle stiffness
+/// σ0 = K/(Fz0·L·level) per direction (K the MF's slip stiffness at the
+/// nominal load, L = 0.2 m longitudinal, 0.35 m lateral: at small slip the
+/// bristles lag like those relaxation lengths; a tyre file's own carcass
+/// stiffness can give metres), so level 2 has twice the lag at small slip.
 pub struct LuGre {
     pub inner: SteadyMf,
     pub model: TransientModel,
 }
 
 impl LuGre {
-    pub fn new(tyre: Tyre) -> Self {
+    pub fn new(tyre: Tyre, level: f64) -> Self {
+        let (fnom, _) = nominal(&tyre);
+        let o = tyre.slip_properties(
+            &MfInput {
+                fz: fnom,
+                vx: 11.0,
+                ..Default::default()
+            },
+            UseMode {
+                limits: false,
+                alpha_star: false,
+                turn_slip: false,
+            },
+        );
+        let l = level.max(1e-3);
+        // At small slip LuGre lags like a relaxation length K/(Fz·σ0).
+        let k = |stiff: f64, len: f64| {
+            let x = stiff.abs() / (fnom * len * l);
+            if x.is_finite() && x > 0.0 {
+                x
+            } else {
+                0.0
+            }
+        };
+        let lugre = crate::transient::LuGreParams {
+            sigma0x: k(o.kxk, 0.2),
+            sigma0y: k(o.kya, 0.35),
+            ..Default::default()
+        };
         LuGre {
             inner: SteadyMf::new(tyre),
-            model: TransientModel::new(TransientConfig {
-                kind: TransientKind::LuGre,
-                input_mode: InputMode::Slips,
-                use_mode: UseMode {
-                    limits: false,
-                    alpha_star: false,
-                    turn_slip: false,
+            model: TransientModel::with_options(
+                TransientConfig {
+                    kind: TransientKind::LuGre,
+                    input_mode: InputMode::Slips,
+                    use_mode: UseMode {
+                        limits: false,
+                        alpha_star: false,
+                        turn_slip: false,
+                    },
                 },
-            }),
+                crate::transient::TransientOptions {
+                    lugre,
+                    ..Default::default()
+                },
+            ),
         }
     }
 }
@@ -199,6 +236,8 @@ pub struct Thermal {
     pub t_opt: f64,
     /// Friction loss at 50 K from the optimum (–): the strength.
     pub k: f64,
+    /// The temperature–friction curve.
+    pub curve: ThermalCurve,
     pub ambient: f64,
     temp: f64,
     last_power: f64,
@@ -215,6 +254,7 @@ impl Thermal {
             share: 0.5,
             t_opt: 70.0,
             k,
+            curve: ThermalCurve::Parabola,
             ambient: 25.0,
             temp: 25.0,
             last_power: 0.0,
@@ -222,9 +262,26 @@ impl Thermal {
     }
     /// Friction scale at tread temperature `t`.
     pub fn mu_scale(&self, t: f64) -> f64 {
-        let x = (t - self.t_opt) / 50.0;
-        (1.0 - self.k * x * x).max(0.3)
+        match self.curve {
+            ThermalCurve::Parabola => {
+                let x = (t - self.t_opt) / 50.0;
+                (1.0 - self.k * x * x).max(0.3)
+            }
+            ThermalCurve::Softening => {
+                (1.0 - self.k * ((t - self.ambient) / 40.0).max(0.0).tanh()).max(0.3)
+            }
+        }
     }
+}
+
+/// Temperature–friction curves of the thermal truth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ThermalCurve {
+    /// μ(T)/μ(Topt) = 1 − k·((T − Topt)/50 K)²: grip peaks at an optimum.
+    Parabola,
+    /// μ(T)/μ(Tamb) = 1 − k·tanh((T − Tamb)/40 K): the compound softens and
+    /// loses grip monotonically as it heats (a second formulation).
+    Softening,
 }
 
 impl TruthModel for Thermal {
@@ -294,6 +351,12 @@ pub enum ScalingKind {
     /// Camber acts as extra slip angle and costs friction:
     /// tan α' = tan α + a·γ·0.1, s = 1 − 2a·γ² (a = strength, γ in rad).
     Camber,
+    /// A second speed–friction form: friction decays exponentially towards a
+    /// sliding level, s = 1 − a·(1 − exp(−Vs/3 m/s)) (a = strength).
+    SpeedFrictionExp,
+    /// A second load-sensitivity form: the classical power law of peak
+    /// friction, s = (Fz/Fnom)^(−a), stiffness unchanged (a = strength).
+    LoadPowerLaw,
 }
 
 impl Scaling {
@@ -335,6 +398,11 @@ impl TruthModel for Scaling {
                 ta += a * 0.1 * m.gamma;
                 (1.0 - 2.0 * a * m.gamma * m.gamma, 1.0)
             }
+            ScalingKind::SpeedFrictionExp => {
+                let vs = m.vx.abs() * (k * k + ta * ta).sqrt();
+                (1.0 - a * (1.0 - (-vs / 3.0).exp()), 1.0)
+            }
+            ScalingKind::LoadPowerLaw => ((1.0 + dfz).max(0.05).powf(-a), 1.0),
         };
         let f = scaled(&self.inner, m, k, ta, s, c);
         output(&self.inner, inp, f, f64::NAN)
@@ -357,13 +425,36 @@ pub fn concealed(name: &str, tyre: Tyre, level: f64) -> Option<Box<dyn TruthMode
     Some(match name {
         "none" => Box::new(SteadyMf::new(tyre)),
         "relaxation" => Box::new(Relaxation::new(tyre, 0.2 * l, 0.35 * l)),
-        "lugre" => Box::new(LuGre::new(tyre)),
+        "lugre" => Box::new(LuGre::new(tyre, l)),
         "thermal" => Box::new(Thermal::new(tyre, 0.15 * l)),
         "load_sensitivity" => Box::new(Scaling::new(tyre, ScalingKind::LoadSensitivity, 0.08 * l)),
         "pressure" => Box::new(Scaling::new(tyre, ScalingKind::Pressure, 0.25 * l)),
         "speed_friction" => Box::new(Scaling::new(tyre, ScalingKind::SpeedFriction, 0.02 * l)),
         "rolling_radius" => Box::new(Scaling::new(tyre, ScalingKind::RollingRadius, 0.01 * l)),
         "camber" => Box::new(Scaling::new(tyre, ScalingKind::Camber, 1.0 * l)),
+        _ => return None,
+    })
+}
+
+/// Second formulations of some effects (other curves for the same physics),
+/// to show that the diagnosis keys on the physical signature, not on
+/// [`concealed`]'s formulas: `thermal` (a softening compound: friction
+/// falls monotonically with temperature, tanh curve, other heat balance),
+/// `speed_friction` (exponential decay with sliding speed),
+/// `load_sensitivity` (power law of peak friction in load). None otherwise.
+pub fn concealed_alt(name: &str, tyre: Tyre, level: f64) -> Option<Box<dyn TruthModel>> {
+    let l = level;
+    Some(match name {
+        "thermal" => {
+            let mut t = Thermal::new(tyre, 0.06 * l);
+            t.curve = ThermalCurve::Softening;
+            t.capacity = 6000.0;
+            t.cooling = 50.0;
+            t.share = 0.6;
+            Box::new(t)
+        }
+        "speed_friction" => Box::new(Scaling::new(tyre, ScalingKind::SpeedFrictionExp, 0.08 * l)),
+        "load_sensitivity" => Box::new(Scaling::new(tyre, ScalingKind::LoadPowerLaw, 0.08 * l)),
         _ => return None,
     })
 }

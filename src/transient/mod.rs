@@ -52,11 +52,13 @@
 //! | 0    | `u`: longitudinal deflection (m), κ' = u/σκ | `zx`: longitudinal bristle (m) |
 //! | 1    | `v`: lateral deflection (m), tan α' = v/σα | `zy`: lateral bristle (m)      |
 //! | 2    | `φ'`: lagged turn slip (1/m)            | –                             |
-//! | 3–7  | reserved (0)                             | reserved (0)                  |
+//! | 3    | tread temperature rise ΔT (K), any model with a `[THERMAL]` extension ([`extension`]) |
+//! | 4–7  | reserved (0)                             | reserved (0)                  |
 //!
 //! The `Steady` model has no state (all slots stay 0). The all-zero state is
 //! the state at rest (what [`TransientModel::reset`] restores).
 
+pub mod extension;
 pub mod lugre;
 pub mod scenario;
 
@@ -587,6 +589,8 @@ pub(crate) struct StepCtx<'a> {
     pub kin: Kinematics,
     pub props: TyreProps,
     pub s: f64,
+    /// Slip-stiffness scale of the extension (1 without one).
+    pub c: f64,
     pub fz: f64,
     pub omega_re: f64,
     /// Whether the force evaluation runs at a raised speed (|Vx| < VXLOW).
@@ -612,7 +616,18 @@ impl StepCtx<'_> {
             kappa: self.dir * sl.kappa,
             ..sl
         };
-        mf_at(self.tyre, base, self.mode, sl, self.s)
+        mf_at(self.tyre, base, self.mode, self.stiff(sl), self.s)
+    }
+
+    /// The slips scaled by the extension's slip-stiffness scale `c`
+    /// (similarity method: stiffness × c); unchanged when c = 1.
+    #[inline]
+    pub fn stiff(&self, sl: Slip) -> Slip {
+        if self.c == 1.0 {
+            sl
+        } else {
+            Slip::new(self.c * sl.kappa, self.c * sl.tan_alpha)
+        }
     }
 
     /// Fx, Fy of [`StepCtx::forces`] only (bit-identical), without the moments.
@@ -622,7 +637,7 @@ impl StepCtx<'_> {
             kappa: self.dir * sl.kappa,
             ..sl
         };
-        mf_at_xy(self.tyre, base, self.mode, sl, self.s)
+        mf_at_xy(self.tyre, base, self.mode, self.stiff(sl), self.s)
     }
 
     /// Low-speed offset correction (N): the MF's force at zero slip at the
@@ -722,6 +737,16 @@ impl TransientModel {
         let probe = tyre.slip_properties_parts(&base, mode, 1.0, want_forces, !steady);
         let props = tyre_props(tyre, &probe, fz, inp.vx.abs());
         let kin = kinematics(self.config.input_mode, inp, props.re);
+        // The extension hook (friction and slip-stiffness scales, see
+        // `extension`); a tyre without one keeps s and c = 1 untouched.
+        let ext = tyre.extension();
+        let (s, c) = match ext {
+            Some(e) => {
+                let (es, ec) = e.scales(&self.state, fz, &kin);
+                (s * es, ec)
+            }
+            None => (s, 1.0),
+        };
         let ctx = StepCtx {
             tyre,
             mode,
@@ -729,6 +754,7 @@ impl TransientModel {
             kin,
             props,
             s,
+            c,
             fz,
             omega_re: inp.omega * props.re,
             floored,
@@ -763,7 +789,7 @@ impl TransientModel {
             if self.config.input_mode == InputMode::Velocities && inp.vx < 0.0 {
                 sl.kappa = -sl.kappa;
             }
-            self.output(&ctx, &mf_at(tyre, &fbase, mode, sl, s), sl)
+            self.output(&ctx, &mf_at(tyre, &fbase, mode, ctx.stiff(sl), s), sl)
         } else {
             match self.config.kind {
                 TransientKind::Relaxation => {
@@ -791,6 +817,9 @@ impl TransientModel {
                 _ => lugre::step(&ctx, &self.options.lugre, &mut next, dt),
             }
         };
+        if let Some(e) = ext {
+            e.advance(&self.state, &mut next, &out, dt);
+        }
         if !steady && fz > FZ_OFF {
             // Rolling resistance at the actual speed and direction (the MF's
             // own low-speed treatment), from the zero-slip probe.

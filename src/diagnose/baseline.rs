@@ -1,0 +1,282 @@
+//! baseline — the tyre the diagnosis compares the recordings with when no
+//! `--tir` is given: the steady-state MF 6.1 fitted to the recordings
+//! themselves through the public fit API ([`crate::fit::mf_fit::fit_mf`]),
+//! starting from the built-in tyre ([`TyreParams::builtin`]) with the
+//! nominal values (FNOMIN, NOMPRES/INFLPRES, LONGVL) taken from the data.
+//!
+//! # What is held, and why
+//! The baseline must not already contain the physics a candidate is meant to
+//! name — a baseline that fitted the pressure terms would hide a pressure
+//! effect, one that fitted relaxation lengths would hide a lag. Held at their
+//! start values:
+//! * the relaxation keys (LONGITUDINAL_STIFFNESS, LATERAL_STIFFNESS, PTX*,
+//!   PTY*, PCFX*/PCFY*): the steady fit has no stage for them, and the
+//!   baseline is replayed steady;
+//! * the pressure terms PPX1–4, PPY1–5 and PPZ1–2: **set to 0** (the
+//!   built-in tyre's values describe another tyre, a 205/60R15 at 2.2 bar)
+//!   and held by fitting the data at one pressure — every sample's pressure
+//!   is set to the median pressure for the fit, so the fit holds the
+//!   pressure terms (it holds them whenever the data hold one pressure). The
+//!   baseline is thus a tyre without pressure dependence, fitted to all
+//!   pressures pooled, and it replays identically at every pressure;
+//! * LMUV (speed-dependent friction) and every other scaling factor: the
+//!   fitter never moves a scaling factor;
+//! * PRESMIN/PRESMAX are widened to the recorded pressures: the replay
+//!   applies the file's range limits as the FMU does, and a clipped pressure
+//!   would make a candidate's pressure terms act at the wrong pressure;
+//! * BREFF, DREFF, FREFF (effective rolling radius) and the vertical keys:
+//!   no steady stage fits them (the replay prescribes the recorded slips).
+//!
+//! # Speed
+//! The fit sees at most [`MAX_FIT_SAMPLES`] samples: a recording is thinned
+//! by a constant stride (segments remapped), which keeps every segment and
+//! both sweep directions — rig recordings at 100 Hz and more carry far more
+//! samples than the 20-odd parameters of a stage need.
+//!
+//! Must never: fit a parameter a candidate owns (above), change the
+//! recordings the diagnosis scores (the fit works on copies), or panic on
+//! a recording without some channel (stages without data are skipped and
+//! reported).
+
+use crate::data::{Recording, SegmentKind};
+use crate::error::Result;
+use crate::fit::mf_fit::{fit_mf, MfFitOptions};
+use crate::fit::mf_stages::{Channel, StageKind};
+use crate::fit::{Holdout, ProgressFn};
+use crate::tir::TyreParams;
+
+/// Largest number of samples the baseline fit sees (all recordings together).
+pub const MAX_FIT_SAMPLES: usize = 40_000;
+
+/// Pressure terms set to 0 and held (see the module docs).
+pub const HELD_PRESSURE_KEYS: [&str; 11] = [
+    "PPX1", "PPX2", "PPX3", "PPX4", "PPY1", "PPY2", "PPY3", "PPY4", "PPY5", "PPZ1", "PPZ2",
+];
+
+/// The fitted baseline and what the fit said.
+pub struct Baseline {
+    pub tyre: TyreParams,
+    /// Stages skipped and why (e.g. "pure Fx: 0 samples").
+    pub skipped: Vec<String>,
+    /// The fit's report (parameters per stage, σ per channel and condition).
+    pub report: crate::fit::FitReport,
+    /// Stride the recordings were thinned by for the fit.
+    pub stride: usize,
+}
+
+/// Every `k`-th sample of `rec` (k ≥ 1), segments, sweep directions, times
+/// in segment and extra channels remapped.
+pub fn decimate(rec: &Recording, k: usize) -> Recording {
+    let k = k.max(1);
+    if k == 1 {
+        return rec.clone();
+    }
+    let pick = |i: usize| i.div_ceil(k);
+    let every = |v: &[f64]| v.iter().step_by(k).copied().collect::<Vec<f64>>();
+    let mut out = Recording {
+        source: rec.source.clone(),
+        samples: rec.samples.iter().step_by(k).cloned().collect(),
+        channels: rec.channels.clone(),
+        extra: rec
+            .extra
+            .iter()
+            .map(|(n, v)| (n.clone(), every(v)))
+            .collect(),
+        segments: Vec::new(),
+        sweep_dir: rec.sweep_dir.iter().step_by(k).copied().collect(),
+        t_in_segment: every(&rec.t_in_segment),
+    };
+    for g in &rec.segments {
+        let (a, b) = (pick(g.start), pick(g.end).min(out.samples.len()));
+        if a < b {
+            let mut h = g.clone();
+            h.start = a;
+            h.end = b;
+            out.segments.push(h);
+        }
+    }
+    out
+}
+
+/// Blank (NaN) each force channel among Fx, Fy, Mz on the segments of a
+/// kind the baseline fit did not fit it on, and drop a channel no stage fit
+/// at all (e.g. Fx of a lateral-only test, where Fx is rig crosstalk). The
+/// stages fit Fx on drive/brake and combined segments, Fy on cornering and
+/// combined ones, Mz on cornering ones only
+/// ([`StageKind::segments_and_channels`]): elsewhere the baseline's value is
+/// the start tyre's, not a fit (Mz under braking comes from SSZ*, which
+/// cornering data cannot determine), and its residual would be named as a
+/// missing physics. Returns the channels dropped entirely; the diagnosis
+/// skips blanked samples (scores, locate, plots).
+pub fn drop_unfitted(recs: &mut [Recording], b: &Baseline) -> Vec<&'static str> {
+    let mut fitted: Vec<(Channel, SegmentKind)> = Vec::new();
+    for st in &b.report.stages {
+        for k in [
+            StageKind::PureFx,
+            StageKind::PureFy,
+            StageKind::Mz,
+            StageKind::Combined,
+        ] {
+            if k.name() == st.stage {
+                let (seg, chans) = k.segments_and_channels();
+                fitted.extend(chans.iter().map(|&c| (c, seg)));
+            }
+        }
+    }
+    let mut out = Vec::new();
+    for c in [Channel::Fx, Channel::Fy, Channel::Mz] {
+        if !recs.iter().any(|r| r.has(c.name())) {
+            continue;
+        }
+        let blank = |s: &mut crate::data::Sample| match c {
+            Channel::Fx => s.fx = f64::NAN,
+            Channel::Fy => s.fy = f64::NAN,
+            _ => s.mz = f64::NAN,
+        };
+        let none = !fitted.iter().any(|f| f.0 == c);
+        for r in recs.iter_mut() {
+            let n = r.samples.len();
+            if none {
+                r.channels.retain(|x| !x.eq_ignore_ascii_case(c.name()));
+                r.samples.iter_mut().for_each(blank);
+                continue;
+            }
+            let segs = r.segments.clone();
+            for g in segs.iter().filter(|g| !fitted.contains(&(c, g.kind))) {
+                r.samples[g.start.min(n)..g.end.min(n)]
+                    .iter_mut()
+                    .for_each(blank);
+            }
+        }
+        if none {
+            out.push(c.name());
+        }
+    }
+    out
+}
+
+/// Median of the finite values of `v` (None when there are none).
+fn median(mut v: Vec<f64>) -> Option<f64> {
+    v.retain(|x| x.is_finite());
+    if v.is_empty() {
+        return None;
+    }
+    let m = v.len() / 2;
+    Some(*v.select_nth_unstable_by(m, f64::total_cmp).1)
+}
+
+/// Widen PRESMIN/PRESMAX to the recorded pressures (±20 %): the replay
+/// runs with the file's range limits on (use mode 111, as the FMU), and a
+/// pressure below PRESMIN would be clipped — the built-in tyre's range
+/// (186–255 kPa) would clip a 0.7–1 bar FSAE tyre to another pressure.
+fn widen_pressure_range(tyre: &mut TyreParams, recs: &[Recording]) -> Result<()> {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for s in recs.iter().flat_map(|r| &r.samples) {
+        if s.p.is_finite() && s.p > 0.0 {
+            lo = lo.min(s.p);
+            hi = hi.max(s.p);
+        }
+    }
+    if lo.is_finite() {
+        if tyre.get("PRESMIN").is_some_and(|v| lo < v) {
+            tyre.set("PRESMIN", 0.8 * lo)?;
+        }
+        if tyre.get("PRESMAX").is_some_and(|v| hi > v) {
+            tyre.set("PRESMAX", 1.2 * hi)?;
+        }
+    }
+    Ok(())
+}
+
+/// Fit the baseline MF 6.1 to `recs` (see the module docs). `threads` for
+/// the fit's evaluation; `progress` receives the fitter's reports.
+pub fn fit_baseline(
+    recs: &[Recording],
+    threads: usize,
+    progress: Option<&mut ProgressFn>,
+) -> Result<Baseline> {
+    let n: usize = recs.iter().map(|r| r.samples.len()).sum();
+    let stride = n.div_ceil(MAX_FIT_SAMPLES).max(1);
+    let p_med = median(
+        recs.iter()
+            .flat_map(|r| r.samples.iter().step_by(10).map(|s| s.p))
+            .collect(),
+    );
+    let data: Vec<Recording> = recs
+        .iter()
+        .map(|r| {
+            let mut d = decimate(r, stride);
+            if let Some(p) = p_med {
+                for s in &mut d.samples {
+                    if s.p.is_finite() {
+                        s.p = p;
+                    }
+                }
+                for g in &mut d.segments {
+                    if g.p.is_finite() {
+                        g.p = p;
+                    }
+                }
+            }
+            d
+        })
+        .collect();
+    let mut start = TyreParams::builtin();
+    for k in HELD_PRESSURE_KEYS {
+        start.set(k, 0.0)?;
+    }
+    let opts = MfFitOptions {
+        holdout: Holdout::None,
+        nominal_from_data: true,
+        threads: threads.max(1),
+        ..Default::default()
+    };
+    let mut fit = fit_mf(&data, start, &opts, progress)?;
+    widen_pressure_range(&mut fit.tyre, recs)?;
+    Ok(Baseline {
+        tyre: fit.tyre,
+        skipped: fit.skipped,
+        report: fit.report,
+        stride,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::{Sample, Segment, SegmentKind};
+
+    /// Thinning by 3 keeps samples 0, 3, 6 …; a segment [4, 10) holds
+    /// original samples 4..9, of which 6 and 9 survive → new indices 2, 3,
+    /// i.e. [ceil(4/3), ceil(10/3)) = [2, 4).
+    #[test]
+    fn decimate_remaps_segments() {
+        let rec = Recording {
+            samples: (0..12)
+                .map(|i| Sample {
+                    time: i as f64,
+                    ..Default::default()
+                })
+                .collect(),
+            segments: vec![Segment {
+                start: 4,
+                end: 10,
+                kind: SegmentKind::PureLateral,
+                fz: 1.0,
+                gamma: 0.0,
+                p: 0.0,
+                vx: 1.0,
+                alpha: 0.0,
+            }],
+            sweep_dir: vec![1; 12],
+            t_in_segment: (0..12).map(|i| i as f64).collect(),
+            ..Default::default()
+        };
+        let d = decimate(&rec, 3);
+        assert_eq!(d.samples.len(), 4);
+        assert_eq!((d.segments[0].start, d.segments[0].end), (2, 4));
+        let times: Vec<f64> = d.samples[2..4].iter().map(|s| s.time).collect();
+        assert_eq!(times, vec![6.0, 9.0]);
+        assert_eq!(d.t_in_segment.len(), 4);
+    }
+}

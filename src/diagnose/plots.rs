@@ -1,0 +1,667 @@
+//! plots — the pictures of a diagnosis (plotters' SVG backend, text as SVG
+//! `<text>`, no font files), one set per force channel the recording has:
+//! * `residual_slip_CH.svg` — residual map: measured − model against the
+//!   driving slip, coloured by load, baseline beside extended model;
+//! * `residual_load_CH.svg` — per segment the relative force scale error
+//!   (Σ r·F / Σ F², the statistic of [`super::locate`]) against load,
+//!   baseline and extended (a load, pressure or friction error shows as a
+//!   trend or an offset);
+//! * `hysteresis_CH.svg` — the residual binned over slip for rising and for
+//!   falling sweeps: a lag opens a loop between them;
+//! * `drift_CH.svg` — the signed residual (+ = measured stronger) against
+//!   time in the run and per segment against the accumulated frictional
+//!   energy: a temperature or wear state drifts;
+//! * `overlay_CH.svg` — measured, baseline and extended model against slip on
+//!   the held-out segments the verdict changes most.
+//!
+//! Must never: draw more than a few thousand points per series (strided),
+//! or fail on a channel the recording lacks (it is skipped).
+
+use super::report::{channel_present, channel_series, pretty, split, Diagnosis, REPORT_CHANNELS};
+use crate::data::Recording;
+use crate::error::{Error, Result};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::Path;
+
+/// Most points drawn per scatter series.
+const MAX_POINTS: usize = 4000;
+/// Slip bins of the hysteresis and drift curves.
+const BINS: usize = 30;
+
+/// A picture written into the report directory.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Plot {
+    /// File name inside the report directory.
+    pub file: String,
+    pub channel: &'static str,
+    /// What to look for, one sentence.
+    pub caption: String,
+}
+
+/// One thing to draw in a panel.
+enum Series {
+    /// Points, colour, legend label, radius (px).
+    Points(Vec<(f64, f64)>, RGBColor, String, u32),
+    Line(Vec<(f64, f64)>, RGBColor, u32, String),
+}
+
+const GREY: RGBColor = RGBColor(150, 150, 150);
+const BASE: RGBColor = RGBColor(31, 119, 180);
+const EXT: RGBColor = RGBColor(214, 39, 40);
+const RISE: RGBColor = RGBColor(31, 119, 180);
+const FALL: RGBColor = RGBColor(255, 127, 14);
+
+fn perr(path: &Path, e: impl std::fmt::Display) -> Error {
+    Error::Other(format!("{}: cannot draw: {e}", path.display()))
+}
+
+fn span<'a>(pts: impl Iterator<Item = &'a (f64, f64)>) -> ((f64, f64), (f64, f64)) {
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for &(x, y) in pts {
+        if x.is_finite() && y.is_finite() {
+            x0 = x0.min(x);
+            x1 = x1.max(x);
+            y0 = y0.min(y);
+            y1 = y1.max(y);
+        }
+    }
+    if x0 > x1 {
+        return ((-1.0, 1.0), (-1.0, 1.0));
+    }
+    let pad = |a: f64, b: f64| ((b - a) * 0.05).max(1e-9 * a.abs().max(b.abs()).max(1e-9));
+    let (px, py) = (pad(x0, x1), pad(y0, y1));
+    ((x0 - px, x1 + px), (y0 - py, y1 + py))
+}
+
+/// Draw `series` into `area` with a title and axis labels; `yr` forces a
+/// common y range (panels compared side by side).
+fn panel(
+    area: &DrawingArea<SVGBackend, Shift>,
+    path: &Path,
+    title: &str,
+    xl: &str,
+    yl: &str,
+    series: &[Series],
+    yr: Option<(f64, f64)>,
+) -> Result<()> {
+    let all = series.iter().flat_map(|s| match s {
+        Series::Points(p, ..) | Series::Line(p, ..) => p.iter(),
+    });
+    let ((x0, x1), (mut y0, mut y1)) = span(all);
+    if let Some((a, b)) = yr {
+        (y0, y1) = (a, b);
+    }
+    let mut ch = ChartBuilder::on(area)
+        .caption(title, ("sans-serif", 15))
+        .margin(8)
+        .x_label_area_size(36)
+        .y_label_area_size(64)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(|e| perr(path, e))?;
+    ch.configure_mesh()
+        .x_desc(xl)
+        .y_desc(yl)
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()
+        .map_err(|e| perr(path, e))?;
+    let mut labelled = false;
+    for s in series {
+        match s {
+            Series::Points(p, c, label, r) => {
+                let (c, r) = (*c, *r);
+                let a = ch
+                    .draw_series(p.iter().map(move |&q| Circle::new(q, r, c.filled())))
+                    .map_err(|e| perr(path, e))?;
+                if !label.is_empty() {
+                    labelled = true;
+                    a.label(label.clone())
+                        .legend(move |(x, y)| Circle::new((x + 8, y), 3, c.filled()));
+                }
+            }
+            Series::Line(p, c, w, label) => {
+                let (c, w) = (*c, *w);
+                let a = ch
+                    .draw_series(LineSeries::new(p.iter().copied(), c.stroke_width(w)))
+                    .map_err(|e| perr(path, e))?;
+                if !label.is_empty() {
+                    labelled = true;
+                    a.label(label.clone()).legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2))
+                    });
+                }
+            }
+        }
+    }
+    if labelled {
+        ch.configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| perr(path, e))?;
+    }
+    Ok(())
+}
+
+/// The panels of a figure.
+type Areas<'a> = [DrawingArea<SVGBackend<'a>, Shift>];
+/// A curve as (x, y) points.
+type Curve = Vec<(f64, f64)>;
+
+/// A figure of `cols` panels side by side.
+fn figure(path: &Path, cols: usize, draw: &dyn Fn(&Areas) -> Result<()>) -> Result<()> {
+    let root = SVGBackend::new(path, (560 * cols as u32, 440)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| perr(path, e))?;
+    let areas = root.split_evenly((1, cols));
+    draw(&areas)?;
+    root.present().map_err(|e| perr(path, e))?;
+    Ok(())
+}
+
+/// Common y range of several point sets (robust: 0.5 % / 99.5 % quantiles,
+/// so a few wild samples do not flatten the picture).
+fn common_range(sets: &[&[(f64, f64)]]) -> (f64, f64) {
+    let mut v: Vec<f64> = sets
+        .iter()
+        .flat_map(|s| s.iter().map(|p| p.1))
+        .filter(|y| y.is_finite())
+        .collect();
+    if v.is_empty() {
+        return (-1.0, 1.0);
+    }
+    v.sort_by(f64::total_cmp);
+    let q = |f: f64| v[((v.len() - 1) as f64 * f) as usize];
+    let (a, b) = (q(0.005), q(0.995));
+    let pad = ((b - a) * 0.08).max(1e-9);
+    (a - pad, b + pad)
+}
+
+/// Per-sample data of one channel for the plots.
+struct Chan<'a> {
+    name: &'static str,
+    unit: &'static str,
+    meas: Vec<f64>,
+    base: Vec<f64>,
+    ext: Vec<f64>,
+    slip: Vec<f64>,
+    slip_label: &'static str,
+    rec: &'a Recording,
+}
+
+impl Chan<'_> {
+    fn r(&self, i: usize, after: bool) -> f64 {
+        self.meas[i] - if after { self.ext[i] } else { self.base[i] }
+    }
+    fn slip_deg(&self, i: usize) -> f64 {
+        if self.name == "FX" {
+            self.slip[i]
+        } else {
+            self.slip[i].to_degrees()
+        }
+    }
+    /// Sample indices inside segments, strided to at most `max`.
+    fn inside(&self, max: usize) -> Vec<usize> {
+        let n: usize = self.rec.segments.iter().map(|g| g.len()).sum();
+        let k = (n / max).max(1);
+        let mut v = Vec::new();
+        for g in &self.rec.segments {
+            v.extend((g.start..g.end.min(self.meas.len())).step_by(k));
+        }
+        v.retain(|&i| self.meas[i].is_finite() && self.base[i].is_finite());
+        v
+    }
+}
+
+/// Draw every picture of the diagnosis into `dir`.
+pub fn draw_all(rec: &Recording, d: &Diagnosis, dir: &Path) -> Result<Vec<Plot>> {
+    let mut out = Vec::new();
+    for (name, unit) in REPORT_CHANNELS {
+        if !channel_present(rec, name) {
+            continue;
+        }
+        let (meas, base, slip) = channel_series(rec, &d.baseline_sim, name);
+        let (_, ext, _) = channel_series(rec, &d.extended_sim, name);
+        let c = Chan {
+            name,
+            unit,
+            meas,
+            base,
+            ext,
+            slip,
+            slip_label: if name == "FX" {
+                "kappa [-]"
+            } else {
+                "alpha [deg]"
+            },
+            rec,
+        };
+        if c.inside(10).is_empty() {
+            continue;
+        }
+        out.push(residual_slip(&c, &d.verdict, dir)?);
+        out.push(residual_load(&c, &d.verdict, dir)?);
+        out.push(hysteresis(&c, &d.verdict, dir)?);
+        out.push(drift(&c, &d.energy, &d.verdict, dir)?);
+        out.push(overlay(&c, &d.verdict, dir)?);
+    }
+    Ok(out)
+}
+
+fn after_label(verdict: &str) -> String {
+    if verdict == "none" {
+        "extended = baseline (verdict none)".into()
+    } else {
+        format!("extended ({verdict})")
+    }
+}
+
+fn residual_slip(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
+    let file = format!("residual_slip_{}.svg", c.name.to_lowercase());
+    let path = dir.join(&file);
+    let idx = c.inside(MAX_POINTS);
+    let mut loads: Vec<i64> = c
+        .rec
+        .segments
+        .iter()
+        .map(|g| (g.fz / 10.0).round() as i64)
+        .collect();
+    loads.sort();
+    loads.dedup();
+    let seg_of = segment_index(c.rec);
+    let series = |after: bool| -> Vec<Series> {
+        loads
+            .iter()
+            .enumerate()
+            .map(|(li, &l)| {
+                let pts: Vec<(f64, f64)> = idx
+                    .iter()
+                    .filter(|&&i| {
+                        seg_of[i].is_some_and(|k| (c.rec.segments[k].fz / 10.0).round() as i64 == l)
+                    })
+                    .map(|&i| (c.slip_deg(i), c.r(i, after)))
+                    .collect();
+                let (r, g, b) = Palette99::pick(li).to_rgba().rgb();
+                Series::Points(pts, RGBColor(r, g, b), format!("Fz {} N", l * 10), 1)
+            })
+            .collect()
+    };
+    let (sb, sa) = (series(false), series(true));
+    let pts = |s: &[Series]| -> Vec<(f64, f64)> {
+        s.iter()
+            .flat_map(|x| match x {
+                Series::Points(p, ..) | Series::Line(p, ..) => p.clone(),
+            })
+            .collect()
+    };
+    let yr = common_range(&[&pts(&sb), &pts(&sa)]);
+    let yl = format!("measured − model [{}]", c.unit);
+    figure(&path, 2, &|a| {
+        panel(
+            &a[0],
+            &path,
+            &format!("{} residual vs slip: baseline", pretty(c.name)),
+            c.slip_label,
+            &yl,
+            &sb,
+            Some(yr),
+        )?;
+        panel(
+            &a[1],
+            &path,
+            &format!(
+                "{} residual vs slip: {}",
+                pretty(c.name),
+                after_label(verdict)
+            ),
+            c.slip_label,
+            &yl,
+            &sa,
+            Some(yr),
+        )
+    })?;
+    Ok(Plot {
+        file,
+        channel: c.name,
+        caption: format!(
+            "{} residual map against slip, coloured by load: structure (a slope at small slip = stiffness error, a bulge near the peak = friction error, a band that splits = hysteresis) should vanish from left to right.",
+            pretty(c.name)
+        ),
+    })
+}
+
+/// Segment index of every sample (None outside segments).
+fn segment_index(rec: &Recording) -> Vec<Option<usize>> {
+    let mut v = vec![None; rec.samples.len()];
+    for (k, g) in rec.segments.iter().enumerate() {
+        for x in v.iter_mut().take(g.end).skip(g.start) {
+            *x = Some(k);
+        }
+    }
+    v
+}
+
+/// Per segment: relative scale error Σ r·F / Σ F² of the model `after` or not.
+fn scale_error(c: &Chan, k: usize, after: bool) -> f64 {
+    let g = &c.rec.segments[k];
+    let (mut srf, mut sff) = (0.0, 0.0);
+    for i in g.start..g.end.min(c.meas.len()) {
+        let f = if after { c.ext[i] } else { c.base[i] };
+        let r = c.r(i, after);
+        if r.is_finite() && f.is_finite() {
+            srf += r * f;
+            sff += f * f;
+        }
+    }
+    if sff > 0.0 {
+        srf / sff
+    } else {
+        f64::NAN
+    }
+}
+
+fn residual_load(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
+    let file = format!("residual_load_{}.svg", c.name.to_lowercase());
+    let path = dir.join(&file);
+    let segs = 0..c.rec.segments.len();
+    let pts = |after: bool| -> Vec<(f64, f64)> {
+        segs.clone()
+            .map(|k| (c.rec.segments[k].fz, 100.0 * scale_error(c, k, after)))
+            .filter(|p| p.0.is_finite() && p.1.is_finite())
+            .collect()
+    };
+    let (b, a) = (pts(false), pts(true));
+    let yr = common_range(&[&b, &a]);
+    figure(&path, 1, &|ar| {
+        panel(
+            &ar[0],
+            &path,
+            &format!("{} force scale error per segment vs load", pretty(c.name)),
+            "Fz [N]",
+            "Σ r·F / Σ F² [%]",
+            &[
+                Series::Points(b.clone(), BASE, "baseline".into(), 3),
+                Series::Points(a.clone(), EXT, after_label(verdict), 3),
+            ],
+            Some(yr),
+        )
+    })?;
+    Ok(Plot {
+        file,
+        channel: c.name,
+        caption: format!(
+            "Per segment, the {} residual as a share of the model force (+ = measured stronger) against load: a trend with load is a load-sensitivity error, scatter between segments at one load a pressure, speed or temperature effect.",
+            pretty(c.name)
+        ),
+    })
+}
+
+/// Mean of y per x bin over `idx`, rising and falling sweeps apart.
+fn binned(c: &Chan, idx: &[usize], y: &dyn Fn(usize) -> f64) -> (Curve, Curve) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for &i in idx {
+        let s = c.slip_deg(i);
+        if s.is_finite() {
+            lo = lo.min(s);
+            hi = hi.max(s);
+        }
+    }
+    if hi <= lo {
+        return (vec![], vec![]);
+    }
+    let mut acc = vec![[0.0f64; 4]; BINS];
+    for &i in idx {
+        let (s, v) = (c.slip_deg(i), y(i));
+        if !(s.is_finite() && v.is_finite()) {
+            continue;
+        }
+        let b = (((s - lo) / (hi - lo)) * BINS as f64).min(BINS as f64 - 1.0) as usize;
+        match c.rec.sweep_dir.get(i) {
+            Some(1) => {
+                acc[b][0] += v;
+                acc[b][1] += 1.0;
+            }
+            Some(-1) => {
+                acc[b][2] += v;
+                acc[b][3] += 1.0;
+            }
+            _ => {}
+        }
+    }
+    let mid = |b: usize| lo + (hi - lo) * (b as f64 + 0.5) / BINS as f64;
+    let curve = |k: usize| {
+        acc.iter()
+            .enumerate()
+            .filter(|(_, a)| a[k + 1] >= 3.0)
+            .map(|(b, a)| (mid(b), a[k] / a[k + 1]))
+            .collect::<Vec<_>>()
+    };
+    (curve(0), curve(2))
+}
+
+fn hysteresis(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
+    let file = format!("hysteresis_{}.svg", c.name.to_lowercase());
+    let path = dir.join(&file);
+    let idx = c.inside(usize::MAX);
+    let (rb, fb) = binned(c, &idx, &|i| c.r(i, false));
+    let (ra, fa) = binned(c, &idx, &|i| c.r(i, true));
+    let yr = common_range(&[&rb, &fb, &ra, &fa]);
+    let yl = format!("mean residual [{}]", c.unit);
+    figure(&path, 2, &|a| {
+        panel(
+            &a[0],
+            &path,
+            &format!(
+                "{} residual, rising vs falling slip: baseline",
+                pretty(c.name)
+            ),
+            c.slip_label,
+            &yl,
+            &[
+                Series::Line(rb.clone(), RISE, 2, "rising".into()),
+                Series::Line(fb.clone(), FALL, 2, "falling".into()),
+            ],
+            Some(yr),
+        )?;
+        panel(
+            &a[1],
+            &path,
+            &format!("{}: {}", pretty(c.name), after_label(verdict)),
+            c.slip_label,
+            &yl,
+            &[
+                Series::Line(ra.clone(), RISE, 2, "rising".into()),
+                Series::Line(fa.clone(), FALL, 2, "falling".into()),
+            ],
+            Some(yr),
+        )
+    })?;
+    Ok(Plot {
+        file,
+        channel: c.name,
+        caption: format!(
+            "Hysteresis: the {} residual averaged in {BINS} slip bins, rising sweeps against falling ones. Two curves apart = the measured force depends on where the slip came from (transient lag, bristle hysteresis); they should close on the right.",
+            pretty(c.name)
+        ),
+    })
+}
+
+fn drift(c: &Chan, energy: &[f64], verdict: &str, dir: &Path) -> Result<Plot> {
+    let file = format!("drift_{}.svg", c.name.to_lowercase());
+    let path = dir.join(&file);
+    let u = |i: usize, after: bool| {
+        let f = if after { c.ext[i] } else { c.base[i] };
+        c.r(i, after) * f.signum()
+    };
+    // Binned over time in run (all segments pooled).
+    let idx = c.inside(usize::MAX);
+    let tmax = idx
+        .iter()
+        .map(|&i| c.rec.t_in_segment.get(i).copied().unwrap_or(f64::NAN))
+        .filter(|t| t.is_finite())
+        .fold(0.0, f64::max);
+    let by_time = |after: bool| {
+        let mut acc = vec![(0.0, 0.0); BINS];
+        for &i in &idx {
+            let t = c.rec.t_in_segment.get(i).copied().unwrap_or(f64::NAN);
+            let v = u(i, after);
+            if t.is_finite() && v.is_finite() && tmax > 0.0 {
+                let b = ((t / tmax) * BINS as f64).min(BINS as f64 - 1.0) as usize;
+                acc[b].0 += v;
+                acc[b].1 += 1.0;
+            }
+        }
+        acc.iter()
+            .enumerate()
+            .filter(|(_, a)| a.1 >= 3.0)
+            .map(|(b, a)| (tmax * (b as f64 + 0.5) / BINS as f64, a.0 / a.1))
+            .collect::<Vec<_>>()
+    };
+    // Per segment mean against the energy at its middle (kJ).
+    let by_energy = |after: bool| {
+        c.rec
+            .segments
+            .iter()
+            .filter_map(|g| {
+                let (mut s, mut n) = (0.0, 0.0);
+                for i in g.start..g.end.min(c.meas.len()) {
+                    let v = u(i, after);
+                    if v.is_finite() {
+                        s += v;
+                        n += 1.0;
+                    }
+                }
+                let e = energy.get((g.start + g.end) / 2).copied()?;
+                (n > 0.0 && e.is_finite()).then(|| (e / 1e3, s / n))
+            })
+            .collect::<Vec<_>>()
+    };
+    let (tb, ta, eb, ea) = (
+        by_time(false),
+        by_time(true),
+        by_energy(false),
+        by_energy(true),
+    );
+    let yl = format!("signed residual, + = measured stronger [{}]", c.unit);
+    figure(&path, 2, &|a| {
+        panel(
+            &a[0],
+            &path,
+            &format!("{} residual vs time in run", pretty(c.name)),
+            "time since the segment began [s]",
+            &yl,
+            &[
+                Series::Line(tb.clone(), BASE, 2, "baseline".into()),
+                Series::Line(ta.clone(), EXT, 2, after_label(verdict)),
+            ],
+            None,
+        )?;
+        panel(
+            &a[1],
+            &path,
+            &format!(
+                "{} residual per segment vs frictional energy",
+                pretty(c.name)
+            ),
+            "accumulated frictional energy [kJ]",
+            &yl,
+            &[
+                Series::Points(eb.clone(), BASE, "baseline".into(), 3),
+                Series::Points(ea.clone(), EXT, after_label(verdict), 3),
+            ],
+            None,
+        )
+    })?;
+    Ok(Plot {
+        file,
+        channel: c.name,
+        caption: format!(
+            "Drift: the signed {} residual (+ = measured stronger than the model) against time within a run and, per segment, against the frictional energy put into the tread since the start. A trend is a state that builds up (tread temperature, wear); it should flatten on the extended model.",
+            pretty(c.name)
+        ),
+    })
+}
+
+fn overlay(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
+    let file = format!("overlay_{}.svg", c.name.to_lowercase());
+    let path = dir.join(&file);
+    let (_, test) = split(c.rec);
+    // Held-out segments ranked by the change the verdict makes (or by the
+    // baseline's error when it changes nothing).
+    let sse = |r: &std::ops::Range<usize>, after: bool| {
+        r.clone()
+            .map(|i| c.r(i, after))
+            .filter(|v| v.is_finite())
+            .map(|v| v * v)
+            .sum::<f64>()
+    };
+    let mut ranked: Vec<(f64, std::ops::Range<usize>)> = test
+        .iter()
+        .filter(|r| r.len() >= 10)
+        .map(|r| {
+            let key = if verdict == "none" {
+                sse(r, false)
+            } else {
+                sse(r, false) - sse(r, true)
+            };
+            (key, r.clone())
+        })
+        .collect();
+    ranked.sort_by(|a, b| b.0.total_cmp(&a.0));
+    ranked.truncate(3);
+    if ranked.is_empty() {
+        ranked = split(c.rec)
+            .0
+            .into_iter()
+            .take(1)
+            .map(|r| (0.0, r))
+            .collect();
+    }
+    let cols = ranked.len().max(1);
+    figure(&path, cols, &|a| {
+        for (k, (_, r)) in ranked.iter().enumerate() {
+            let stride = (r.len() / 1500).max(1);
+            let line = |v: &[f64]| -> Vec<(f64, f64)> {
+                r.clone()
+                    .step_by(stride)
+                    .map(|i| (c.slip_deg(i), v[i]))
+                    .filter(|p| p.0.is_finite() && p.1.is_finite())
+                    .collect()
+            };
+            let g = c.rec.segments.iter().find(|g| g.start == r.start);
+            let title = g.map_or("segment".into(), |g| {
+                format!(
+                    "Fz {:.0} N, γ {:.1}°, p {:.0} kPa, {:.1} m/s",
+                    g.fz,
+                    g.gamma.to_degrees(),
+                    g.p / 1e3,
+                    g.vx
+                )
+            });
+            let mut series = vec![
+                Series::Points(line(&c.meas), GREY, "measured".into(), 1),
+                Series::Line(line(&c.base), BASE, 1, "baseline".into()),
+            ];
+            if verdict != "none" {
+                series.push(Series::Line(line(&c.ext), EXT, 1, after_label(verdict)));
+            }
+            panel(
+                &a[k],
+                &path,
+                &title,
+                c.slip_label,
+                &format!("{} [{}]", pretty(c.name), c.unit),
+                &series,
+                None,
+            )?;
+        }
+        Ok(())
+    })?;
+    Ok(Plot {
+        file,
+        channel: c.name,
+        caption: format!(
+            "Measured (grey), baseline (blue) and extended model (red) {} on the held-out segments the verdict changes most (segments the candidates were not fitted on).",
+            pretty(c.name)
+        ),
+    })
+}

@@ -1,0 +1,244 @@
+//! extension — physics beyond the steady Magic Formula that the diagnosis can
+//! name and fit, read once from the tyre file (at [`crate::mf::Tyre::new`])
+//! and applied inside [`super::TransientModel::step`] — the code the FMU and
+//! `replay` run — through one hook: a friction scale `s` and a slip-stiffness
+//! scale `c` per step, applied with the similarity method (Pacejka, *Tyre and
+//! Vehicle Dynamics*, 3rd ed., §4.3.2): F(κ) → s·F(c·κ/s), i.e. peak × s,
+//! slip stiffness × c (`StepCtx::forces`, [`super::mf_at`]).
+//!
+//! The scales are a product of:
+//! * **load sensitivity** (`[LOAD_SENSITIVITY]`, keys `MU_DFZ1`, `MU_DFZ2`,
+//!   `K_DFZ1`): polynomial corrections in dfz = (Fz − Fz0)/Fz0 beyond the MF
+//!   forms, s = 1 + MU_DFZ1·dfz + MU_DFZ2·dfz², c = 1 + K_DFZ1·dfz — the
+//!   role the η-corrections play for heavy radial tyres.
+//! * **sliding-speed friction** (the MF's own `LMUV` with `LONGVL` = V0):
+//!   s = 1/(1 + LMUV·Vs/V0), Vs = |Vx|·√(κ² + tan²α) the sliding speed
+//!   (MF 6.1, Pacejka 3rd ed. eq. 4.E7: λμ* = λμ/(1 + λμV·Vs/V0)). The
+//!   steady [`crate::mf::Tyre::evaluate`] does not apply LMUV (MFeval 4.0
+//!   does not either, and no reference file sets it); the step does.
+//! * **tread temperature** (`[THERMAL]`, keys `CAPACITY` J/K, `COOLING` W/K,
+//!   `SHARE` –, `MU_T0`, `MU_T1`, `MU_T2` –; temperatures relative to the
+//!   ambient air): a lumped heat balance C·dT/dt = q·P − h·(T − Tamb) with
+//!   P = |Fx·Vsx| + |Fy·Vsy| the frictional power (the thermal models of
+//!   Sorniotti 2009 / the TRT family reduced to one node), and the friction
+//!   s = 1 + MU_T0 + MU_T1·x + MU_T2·x², x = (T − Tamb)/50 K. The state
+//!   ΔT = T − Tamb is slot [`SLOT_TEMP`] of the transient state (so it is
+//!   part of fmi2GetFMUstate, and reset restores the ambient); it is updated
+//!   exactly for the power of the step held (explicit in the coupling).
+//!
+//! Pressure, camber and the rolling radius need no hook: they are the MF's
+//! own keys (PPX*/PPY*, the camber terms, Q_RE0/FREFF of Re(Fz)).
+//!
+//! Must never: change anything for a tyre without these keys (the hook is
+//! `None`, the outputs stay bit-identical), allocate, or return a
+//! non-positive scale.
+
+use super::{Kinematics, TransientState, WheelOutput};
+use crate::tir::TyreParams;
+
+/// Slot of the tread temperature rise ΔT = T − Tamb (K) in `TransientState::x`.
+pub const SLOT_TEMP: usize = 3;
+/// Section of the load-sensitivity corrections.
+pub const LOAD_SECTION: &str = "LOAD_SENSITIVITY";
+/// Keys of [`LOAD_SECTION`].
+pub const LOAD_KEYS: [&str; 3] = ["MU_DFZ1", "MU_DFZ2", "K_DFZ1"];
+/// Section of the tread-temperature model.
+pub const THERMAL_SECTION: &str = "THERMAL";
+/// Keys of [`THERMAL_SECTION`].
+pub const THERMAL_KEYS: [&str; 6] = ["CAPACITY", "COOLING", "SHARE", "MU_T0", "MU_T1", "MU_T2"];
+/// Temperature scale of the friction polynomial (K).
+pub const T_SCALE: f64 = 50.0;
+/// Smallest scale the hook returns (a guard, not physics).
+const S_MIN: f64 = 0.05;
+
+/// The lumped tread-temperature model (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Thermal {
+    /// Heat capacity of the tread layer C (J/K).
+    pub capacity: f64,
+    /// Heat loss to air and carcass h (W/K).
+    pub cooling: f64,
+    /// Share q of the frictional power heating the tread (–).
+    pub share: f64,
+    /// Friction polynomial in x = ΔT/50 K: s = 1 + mu[0] + mu[1]·x + mu[2]·x².
+    pub mu: [f64; 3],
+}
+
+impl Thermal {
+    /// Friction scale at a temperature rise `dt_k` (K).
+    #[inline]
+    pub fn friction(&self, dt_k: f64) -> f64 {
+        let x = dt_k / T_SCALE;
+        1.0 + self.mu[0] + self.mu[1] * x + self.mu[2] * x * x
+    }
+    /// Time constant C/h (s).
+    pub fn time_constant(&self) -> f64 {
+        self.capacity / self.cooling
+    }
+}
+
+/// The extension physics of one tyre (None fields: not in the file).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct Extension {
+    /// (MU_DFZ1, MU_DFZ2, K_DFZ1).
+    pub load: Option<[f64; 3]>,
+    /// LMUV and V0 (LONGVL, m/s).
+    pub lmuv: Option<(f64, f64)>,
+    pub thermal: Option<Thermal>,
+    /// Nominal load Fz0 = FNOMIN·LFZO (N).
+    pub fz0: f64,
+}
+
+fn number(t: &TyreParams, sec: &str, key: &str) -> crate::Result<Option<f64>> {
+    match t.extra(sec, key) {
+        None => Ok(None),
+        Some(_) => match t.extra_number(sec, key) {
+            Some(x) if x.is_finite() => Ok(Some(x)),
+            _ => Err(crate::Error::Tir {
+                file: t.source.clone(),
+                line: 0,
+                key: key.into(),
+                message: format!("[{sec}] {key}: expected a finite number"),
+            }),
+        },
+    }
+}
+
+impl Extension {
+    /// The extension a tyre file describes, or None when it has none (then
+    /// the step is exactly the plain model's). Errors name the file and key.
+    pub fn from_params(t: &TyreParams) -> crate::Result<Option<Extension>> {
+        let p = &t.p;
+        let bad = |key: &str, msg: &str| crate::Error::Tir {
+            file: t.source.clone(),
+            line: 0,
+            key: key.into(),
+            message: msg.into(),
+        };
+        let mut e = Extension {
+            fz0: {
+                let f = p.fnomin * p.lfzo;
+                if f.is_finite() && f > 0.0 {
+                    f
+                } else {
+                    4000.0
+                }
+            },
+            ..Default::default()
+        };
+        let mut load = [0.0; 3];
+        let mut any = false;
+        for (v, k) in load.iter_mut().zip(LOAD_KEYS) {
+            if let Some(x) = number(t, LOAD_SECTION, k)? {
+                *v = x;
+                any = true;
+            }
+        }
+        if any && load.iter().any(|x| *x != 0.0) {
+            e.load = Some(load);
+        }
+        if p.lmuv != 0.0 {
+            if !p.lmuv.is_finite() || p.lmuv < 0.0 {
+                return Err(bad("LMUV", "expected a finite number >= 0"));
+            }
+            let v0 = if p.longvl.is_finite() && p.longvl > 0.0 {
+                p.longvl
+            } else {
+                return Err(bad("LONGVL", "LMUV needs a positive LONGVL (V0)"));
+            };
+            e.lmuv = Some((p.lmuv, v0));
+        }
+        let mut th = [f64::NAN; 6];
+        let mut any = false;
+        for (v, k) in th.iter_mut().zip(THERMAL_KEYS) {
+            if let Some(x) = number(t, THERMAL_SECTION, k)? {
+                *v = x;
+                any = true;
+            }
+        }
+        if any {
+            let or = |x: f64, d: f64| if x.is_nan() { d } else { x };
+            let m = Thermal {
+                capacity: or(th[0], 4000.0),
+                cooling: or(th[1], 40.0),
+                share: or(th[2], 0.5),
+                mu: [or(th[3], 0.0), or(th[4], 0.0), or(th[5], 0.0)],
+            };
+            if !(m.capacity > 0.0 && m.cooling > 0.0 && m.share >= 0.0) {
+                return Err(bad(
+                    "CAPACITY",
+                    "[THERMAL] needs CAPACITY > 0, COOLING > 0, SHARE >= 0",
+                ));
+            }
+            e.thermal = Some(m);
+        }
+        Ok(
+            if e.load.is_some() || e.lmuv.is_some() || e.thermal.is_some() {
+                Some(e)
+            } else {
+                None
+            },
+        )
+    }
+
+    /// Write these parameters into `t` (sections and LMUV), replacing what
+    /// was there, so that `Tyre::new` reads them back.
+    pub fn write_to(&self, t: &mut TyreParams) {
+        if let Some(l) = self.load {
+            let s = t.extra_section(LOAD_SECTION);
+            for (k, v) in LOAD_KEYS.iter().zip(l) {
+                s.set(k, v);
+            }
+        }
+        if let Some((lmuv, _)) = self.lmuv {
+            t.p.lmuv = lmuv;
+        }
+        if let Some(m) = self.thermal {
+            let s = t.extra_section(THERMAL_SECTION);
+            let v = [m.capacity, m.cooling, m.share, m.mu[0], m.mu[1], m.mu[2]];
+            for (k, v) in THERMAL_KEYS.iter().zip(v) {
+                s.set(k, v);
+            }
+        }
+    }
+
+    /// Friction and slip-stiffness scales (s, c) for this step, from the
+    /// load, the kinematic sliding speed and the temperature in `st`.
+    #[inline]
+    pub fn scales(&self, st: &TransientState, fz: f64, kin: &Kinematics) -> (f64, f64) {
+        let (mut s, mut c) = (1.0, 1.0);
+        if let Some([m1, m2, k1]) = self.load {
+            let dfz = (fz - self.fz0) / self.fz0;
+            s *= 1.0 + m1 * dfz + m2 * dfz * dfz;
+            c *= 1.0 + k1 * dfz;
+        }
+        if let Some((lmuv, v0)) = self.lmuv {
+            let vs = kin.vx_abs * (kin.kappa * kin.kappa + kin.tan_alpha * kin.tan_alpha).sqrt();
+            s /= 1.0 + lmuv * vs / v0;
+        }
+        if let Some(m) = self.thermal {
+            s *= m.friction(st.x[SLOT_TEMP]);
+        }
+        let g = |x: f64| if x.is_finite() { x.max(S_MIN) } else { 1.0 };
+        (g(s), g(c))
+    }
+
+    /// Advance the extension states over `dt` from `prev` into `next` with
+    /// the step's output held (the thermal node, exact for the held power).
+    #[inline]
+    pub fn advance(
+        &self,
+        prev: &TransientState,
+        next: &mut TransientState,
+        out: &WheelOutput,
+        dt: f64,
+    ) {
+        if let Some(m) = self.thermal {
+            let p = (out.fx * out.vsx).abs() + (out.fy * out.vsy).abs();
+            let p = if p.is_finite() { p } else { 0.0 };
+            let eq = m.share * p / m.cooling;
+            let t0 = prev.x[SLOT_TEMP];
+            next.x[SLOT_TEMP] = eq + (t0 - eq) * (-dt / m.time_constant()).exp();
+        }
+    }
+}

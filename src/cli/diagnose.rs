@@ -9,6 +9,7 @@
 //! Must never: panic on bad input (errors name the file or flag), or draw
 //! progress when stderr is not a terminal.
 
+use crate::data::{load, LoadOptions, ReChoice};
 use crate::diagnose::baseline::{drop_unfitted, fit_baseline, HELD_PRESSURE_KEYS};
 use crate::diagnose::replay::ReplayOptions;
 use crate::diagnose::report::{diagnose_with, merge};
@@ -32,6 +33,14 @@ pub struct Args {
     /// Baseline tyre (.tir). Default: fit the steady MF 6.1 to the recordings.
     #[arg(long)]
     pub tir: Option<PathBuf>,
+    /// Effective rolling radius for κ = Ω·Re/(V·cos α) − 1 where κ is computed
+    /// from wheel speed: model (the baseline's Re(Fz); the default with --tir),
+    /// free-rolling (Re(Fz) fitted on the recording's free-rolling samples; the
+    /// default without --tir), recorded or loaded. With --tir, `free-rolling`
+    /// would absorb part of a rolling-radius effect into κ before the
+    /// diagnosis sees it, and leaves a load-dependent κ bias of its own.
+    #[arg(long)]
+    pub re: Option<String>,
 }
 
 fn bar(len: u64, template: &str) -> Option<ProgressBar> {
@@ -48,10 +57,6 @@ fn bar(len: u64, template: &str) -> Option<ProgressBar> {
 /// Run the command.
 pub fn run(a: Args) -> Result<()> {
     let t0 = std::time::Instant::now();
-    let mut recs: Vec<crate::data::Recording> = Vec::new();
-    for p in &a.recordings {
-        recs.push(crate::data::Recording::from_file(p)?);
-    }
     if let Some(tir) = &a.tir {
         if !tir.is_file() {
             return Err(Error::Input(format!(
@@ -60,13 +65,34 @@ pub fn run(a: Args) -> Result<()> {
             )));
         }
     }
+    let given = a.tir.as_ref().map(|t| Tyre::from_file(t)).transpose()?;
+    let re = match (a.re.as_deref(), &given) {
+        (None | Some("model"), Some(t)) => ReChoice::Model(Box::new(t.clone())),
+        (None, None) => ReChoice::FreeRolling,
+        (Some("model"), None) => {
+            return Err(Error::Input("--re model needs --tir FILE".into()));
+        }
+        (Some(r), _) => ReChoice::parse(r).ok_or_else(|| {
+            Error::Input(format!(
+                "--re '{r}': expected model, free-rolling, recorded or loaded"
+            ))
+        })?,
+    };
+    let opts = LoadOptions {
+        re,
+        ..Default::default()
+    };
+    let mut recs: Vec<crate::data::Recording> = Vec::new();
+    for p in &a.recordings {
+        recs.push(load(p, &opts)?.recording);
+    }
     std::fs::create_dir_all(&a.report).map_err(|e| Error::io(&a.report, e))?;
-    let (tyre, note) = match &a.tir {
-        Some(tir) => (
-            Tyre::from_file(tir)?,
+    let (tyre, note) = match (&a.tir, given) {
+        (Some(tir), Some(t)) => (
+            t,
             format!("Baseline: {} (given with --tir).", tir.display()),
         ),
-        None => {
+        _ => {
             let b = bar(100, "{prefix:>12} [{bar:30}] {pos}/{len} {msg}");
             let mut cb = |p: &Progress| {
                 if let Some(b) = &b {

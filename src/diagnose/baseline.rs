@@ -225,12 +225,18 @@ pub fn fit_baseline(
     for k in HELD_PRESSURE_KEYS {
         start.set(k, 0.0)?;
     }
-    let opts = MfFitOptions {
+    let mut opts = MfFitOptions {
         holdout: Holdout::None,
         nominal_from_data: true,
         threads: threads.max(1),
         ..Default::default()
     };
+    // Initial LM damping 1e-3, the value this baseline was validated with
+    // (rig recordings, TyreData.csv). `tyrekit fit` now defaults to 1e-2
+    // (better on its pure-Fy benchmark); on TyreData.csv that default lands
+    // in a worse minimum of this baseline (held-out σ_Fy 11.7 % against
+    // 4.7 %), which an in-sample criterion over Fy and Mz did not catch.
+    opts.fit.lm.lambda0 = 1e-3;
     let mut fit = fit_mf(&data, start, &opts, progress)?;
     widen_pressure_range(&mut fit.tyre, recs)?;
     Ok(Baseline {

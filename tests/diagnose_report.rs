@@ -28,6 +28,15 @@ fn tmp(tag: &str) -> PathBuf {
     d
 }
 
+/// Remove a test's folder, or keep it (and say where) when `KEEP` is set.
+fn cleanup(dir: &Path) {
+    if std::env::var_os("KEEP").is_none() {
+        let _ = std::fs::remove_dir_all(dir);
+    } else {
+        eprintln!("kept {}", dir.display());
+    }
+}
+
 fn run_diagnose(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_tyrekit"))
         .arg("diagnose")
@@ -117,11 +126,7 @@ fn no_tir_on_rig_recording() {
     let base = Tyre::from_file(&rep.join("baseline.tir")).unwrap();
     assert_eq!(base.params().p.ppy1, 0.0);
     assert_eq!(base.params().p.ppx1, 0.0);
-    if std::env::var_os("KEEP").is_none() {
-        let _ = std::fs::remove_dir_all(&dir);
-    } else {
-        eprintln!("kept {}", dir.display());
-    }
+    cleanup(&dir);
 }
 
 /// The real flat-belt lateral test (MFeval's fitting example): runs end to
@@ -152,11 +157,7 @@ fn real_tyre_data_end_to_end() {
         .as_f64()
         .unwrap();
     assert!(fy < 0.08, "baseline FY σ {fy}");
-    if std::env::var_os("KEEP").is_none() {
-        let _ = std::fs::remove_dir_all(&dir);
-    } else {
-        eprintln!("kept {}", dir.display());
-    }
+    cleanup(&dir);
 }
 
 fn finding(name: &'static str, groups: &[(&str, f64)]) -> Finding {

@@ -506,6 +506,65 @@ impl Tyre {
         }
     }
 
+    /// Re of [`Tyre::slip_properties_mu`] alone (bit-identical: the same
+    /// conditioning at κ = α = 0 and the same radius iteration), without the
+    /// Magic Formula. For the steady transient step, which takes the other
+    /// zero-slip properties from its force evaluation
+    /// ([`Tyre::forces_and_props`]).
+    pub fn zero_slip_radius(&self, inp: &MfInput, mode: UseMode) -> f64 {
+        let zero = MfInput {
+            kappa: 0.0,
+            alpha: 0.0,
+            ..*inp
+        };
+        self.conditions_radius(&zero, mode).2[0]
+    }
+
+    /// [`Tyre::forces_mu`] and, from the same evaluation, the slip-independent
+    /// fields of [`Tyre::slip_properties_mu`] for the same input: μx, μy, Kxκ,
+    /// Kyα, Cx, Cy, σx, σy and γ. Without turn slip these are bit-identical to
+    /// the zero-slip probe's: none of them depends on κ or α (Pacejka 3rd ed.
+    /// 4.E13, 4.E23, 4.E15, 4.E25 with ζ3 = 1; the carcass stiffnesses and
+    /// relaxation lengths use only Fz, p, γ), and the conditioned Fz, p, γ are
+    /// those of the probe — so one evaluation serves both. With turn slip Kyα
+    /// carries ζ3(φ), which depends on α: use the probe then. `re`, `fx`,
+    /// `fy`, `my` of the returned properties are NaN (not computed here).
+    /// Allocation-free.
+    pub fn forces_and_props(
+        &self,
+        inp: &MfInput,
+        mode: UseMode,
+        mu_scale: f64,
+    ) -> (Forces, SlipProps) {
+        let (c, _) = self.conditions(inp, mode);
+        let s = self.model.solve_mu(&c, mu_scale);
+        let is52 = self.model.form != Form::Mf6;
+        let (cx, cy, sigmax, sigmay) = extras::relaxation(&self.params.p, is52, &c, s.kxk, s.kya);
+        let forces = Forces {
+            fx: s.fx,
+            fy: s.fy,
+            mx: s.mx,
+            my: s.my,
+            mz: s.mz,
+        };
+        let props = SlipProps {
+            re: f64::NAN,
+            cx,
+            cy,
+            kxk: s.kxk,
+            kya: s.kya,
+            sigmax,
+            sigmay,
+            mux: s.mux,
+            muy: if mode.limits { s.muy.abs() } else { s.muy },
+            fx: f64::NAN,
+            fy: f64::NAN,
+            my: f64::NAN,
+            gamma: c.gamma_u,
+        };
+        (forces, props)
+    }
+
     /// [`Tyre::slip_properties_mu`] with `mu_scale = 1`.
     pub fn slip_properties(&self, inp: &MfInput, mode: UseMode) -> SlipProps {
         self.slip_properties_mu(inp, mode, 1.0)
@@ -529,5 +588,88 @@ impl Tyre {
         if n > 1 {
             out[n - 1].inst_kya = out[n - 2].inst_kya;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The claim of [`Tyre::forces_and_props`]: without turn slip its
+    /// properties are the zero-slip probe's, bit for bit, and its forces are
+    /// [`Tyre::forces_mu`]'s — over slips, loads (below FZMIN, above FZMAX,
+    /// 0), pressures, cambers, speeds (reversing, below VXLOW, 0), both
+    /// limit modes and α*, for every equation family shipped in ../shared.
+    #[test]
+    fn forces_and_props_equal_the_probe_bitwise() {
+        let mut tyres = vec![Tyre::builtin()];
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/tir");
+        let mut files: Vec<_> = std::fs::read_dir(&dir)
+            .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
+            .unwrap_or_default();
+        files.sort();
+        // Files the loader refuses (deliberately broken templates) are skipped.
+        tyres.extend(files.iter().filter_map(|f| Tyre::from_file(f).ok()));
+        let forms = |f: Form| tyres.iter().filter(|t| t.model().form == f).count();
+        assert!(
+            forms(Form::Mf6) >= 2 && forms(Form::Mf52) + forms(Form::Pac2002) >= 2,
+            "expected MF 6.x and MF 5.2/PAC2002 files in {}",
+            dir.display()
+        );
+        let bits = |x: f64| if x.is_nan() { u64::MAX } else { x.to_bits() };
+        let mut n = 0;
+        for tyre in &tyres {
+            for code in [111, 121, 211, 221] {
+                let mode = UseMode::from_code(code).unwrap();
+                for fz in [0.0, 50.0, 1500.0, 4000.0, 9000.0, 40000.0] {
+                    for (kappa, alpha) in [(0.0, 0.0), (0.05, -0.1), (-0.4, 0.3), (1.5, 1.2)] {
+                        for vx in [-15.0, -0.3, 0.0, 0.5, 20.0] {
+                            for (gamma, p) in [(0.0, 0.0), (0.05, 1.8e5), (-0.1, 2.6e5)] {
+                                let inp = MfInput {
+                                    fz,
+                                    kappa,
+                                    alpha,
+                                    gamma,
+                                    vx,
+                                    p,
+                                    omega: vx / 0.3,
+                                    ..Default::default()
+                                };
+                                let (f, a) = tyre.forces_and_props(&inp, mode, 1.0);
+                                let b = tyre.slip_properties_mu(&inp, mode, 1.0);
+                                let g = tyre.forces_mu(&inp, mode, 1.0);
+                                let pairs = [
+                                    (a.mux, b.mux),
+                                    (a.muy, b.muy),
+                                    (a.kxk, b.kxk),
+                                    (a.kya, b.kya),
+                                    (a.cx, b.cx),
+                                    (a.cy, b.cy),
+                                    (a.sigmax, b.sigmax),
+                                    (a.sigmay, b.sigmay),
+                                    (a.gamma, b.gamma),
+                                    (f.fx, g.fx),
+                                    (f.fy, g.fy),
+                                    (f.mx, g.mx),
+                                    (f.my, g.my),
+                                    (f.mz, g.mz),
+                                ];
+                                for (i, (x, y)) in pairs.into_iter().enumerate() {
+                                    assert_eq!(
+                                        bits(x),
+                                        bits(y),
+                                        "{} field {i}: {x} vs {y} at {inp:?} mode {code}",
+                                        tyre.params().source
+                                    );
+                                }
+                                assert_eq!(bits(tyre.zero_slip_radius(&inp, mode)), bits(b.re));
+                                n += 1;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(n >= 5 * 1440, "{n} cases");
     }
 }

@@ -30,7 +30,10 @@
 //!    "probe", the pure-slip equations only): Re, μx, μy, Cx, Cy, Kxκ, Kyα,
 //!    σκ, σα (slip-independent); Fx, Fy at zero slip only where they are used
 //!    (below VXLOW, LuGre), and My (rolling resistance with the MF's own
-//!    low-speed/direction handling) only for the transient models.
+//!    low-speed/direction handling) only for the transient models. The
+//!    steady model without turn slip probes Re only: its force evaluation
+//!    ([`Tyre::forces_and_props`]) gives the slip-independent rest, the same
+//!    bits, so one Magic Formula evaluation per step.
 //! 2. [`Tyre::forces`] at the slips the model uses. For the transient models
 //!    the MF sees the speed sgn(Vx)·max(|Vx|, VXLOW) — they do low speed
 //!    themselves (MFeval's steady low-speed slip reduction would remove the
@@ -427,7 +430,7 @@ pub fn tyre_props(tyre: &Tyre, o: &SlipProps, fz: f64, vx_abs: f64) -> TyreProps
         }
     };
     TyreProps {
-        re: pos(o.re, r0),
+        re: rolling_radius(tyre, o.re),
         cx,
         cy,
         sigma_x,
@@ -448,6 +451,14 @@ pub fn tyre_props(tyre: &Tyre, o: &SlipProps, fz: f64, vx_abs: f64) -> TyreProps
     }
 }
 
+/// The effective rolling radius in use: the MF's Re when it is a positive
+/// number, else UNLOADED_RADIUS (else 0.3 m).
+#[inline]
+fn rolling_radius(tyre: &Tyre, re: f64) -> f64 {
+    let pos = |x: f64, fb: f64| if x.is_finite() && x > 0.0 { x } else { fb };
+    pos(re, pos(tyre.params().p.unloaded_radius, 0.3))
+}
+
 /// Magic Formula forces at slips (κ, tan α) on a road of friction scale `s`
 /// (the hot-path [`Tyre::forces`]; the slip-independent outputs come from the
 /// probe, see [`tyre_props`]).
@@ -462,7 +473,26 @@ pub fn tyre_props(tyre: &Tyre, o: &SlipProps, fz: f64, vx_abs: f64) -> TyreProps
 /// make this exact — see the transient report.
 #[inline]
 pub fn mf_at(tyre: &Tyre, base: &MfInput, mode: UseMode, slip: Slip, s: f64) -> Forces {
-    let mut o = tyre.forces(&similar_input(base, slip, s), mode);
+    similar_forces(tyre.forces(&similar_input(base, slip, s), mode), s)
+}
+
+/// [`mf_at`] plus the slip-independent properties of the same evaluation
+/// ([`Tyre::forces_and_props`]; at the MF's own friction, as the probe).
+#[inline]
+fn mf_at_props(
+    tyre: &Tyre,
+    base: &MfInput,
+    mode: UseMode,
+    slip: Slip,
+    s: f64,
+) -> (Forces, SlipProps) {
+    let (f, p) = tyre.forces_and_props(&similar_input(base, slip, s), mode, 1.0);
+    (similar_forces(f, s), p)
+}
+
+/// The similarity method's force scaling of [`mf_at`] (Fx, Fy, Mx, Mz × s).
+#[inline]
+fn similar_forces(mut o: Forces, s: f64) -> Forces {
     if s != 1.0 {
         o.fx *= s;
         o.fy *= s;
@@ -525,6 +555,16 @@ impl Slip {
             tan_alpha: k.tan_alpha,
             alpha: k.alpha,
         }
+    }
+}
+
+/// The slips scaled by a slip-stiffness scale `c` (see [`StepCtx::stiff`]).
+#[inline]
+fn stiff_slip(c: f64, sl: Slip) -> Slip {
+    if c == 1.0 {
+        sl
+    } else {
+        Slip::new(c * sl.kappa, c * sl.tan_alpha)
     }
 }
 
@@ -623,11 +663,7 @@ impl StepCtx<'_> {
     /// (similarity method: stiffness × c); unchanged when c = 1.
     #[inline]
     pub fn stiff(&self, sl: Slip) -> Slip {
-        if self.c == 1.0 {
-            sl
-        } else {
-            Slip::new(self.c * sl.kappa, self.c * sl.tan_alpha)
-        }
+        stiff_slip(self.c, sl)
     }
 
     /// Fx, Fy of [`StepCtx::forces`] only (bit-identical), without the moments.
@@ -690,7 +726,8 @@ impl TransientModel {
     /// Advance by `dt` seconds with inputs held constant over the step and
     /// return the outputs at the end of the step. On error the state is unchanged.
     ///
-    /// Cost: one zero-slip probe (pure-slip equations, for Re, μ, the
+    /// Cost: the steady model without turn slip, one forces evaluation (and
+    /// the radius); otherwise one zero-slip probe (pure-slip equations, for Re, μ, the
     /// stiffnesses and relaxation lengths; the zero-slip forces and My only
     /// where used) and one forces-only evaluation; below VXLOW one Fx/Fy-only
     /// one more (zero-slip offsets); LuGre two Fx/Fy-only ones (cross terms);
@@ -734,8 +771,26 @@ impl TransientModel {
         // force evaluation's). The rest of `SlipProps` is always computed.
         let floored = fbase.vx != base.vx;
         let want_forces = floored || self.config.kind == TransientKind::LuGre;
-        let probe = tyre.slip_properties_parts(&base, mode, 1.0, want_forces, !steady);
-        let props = tyre_props(tyre, &probe, fz, inp.vx.abs());
+        // The steady model on the ground without turn slip needs from the
+        // probe only Re (for the slips): its force evaluation gives μ, Kxκ,
+        // Kyα, C and σ too, bit-identical to the probe's
+        // ([`Tyre::forces_and_props`]), so the probe's Magic Formula is skipped.
+        let fast = steady && !mode.turn_slip && fz > FZ_OFF;
+        let (mut probe, mut props) = if fast {
+            let probe = SlipProps {
+                re: tyre.zero_slip_radius(&base, mode),
+                ..Default::default()
+            };
+            let props = TyreProps {
+                re: rolling_radius(tyre, probe.re),
+                ..Default::default()
+            };
+            (probe, props)
+        } else {
+            let probe = tyre.slip_properties_parts(&base, mode, 1.0, want_forces, !steady);
+            let props = tyre_props(tyre, &probe, fz, inp.vx.abs());
+            (probe, props)
+        };
         let kin = kinematics(self.config.input_mode, inp, props.re);
         // The extension hook (friction and slip-stiffness scales, see
         // `extension`); a tyre without one keeps s and c = 1 untouched.
@@ -746,6 +801,25 @@ impl TransientModel {
                 (s * es, ec)
             }
             None => (s, 1.0),
+        };
+        let dir = if self.config.input_mode == InputMode::Velocities && inp.vx < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
+        // The steady model's slips: the MF convention κ = −Vsx/Vx with the
+        // sign of Vx (MFeval flips Fx for Vx < 0 itself).
+        let steady_slip = Slip {
+            kappa: dir * kin.kappa,
+            ..Slip::of(&kin)
+        };
+        let solved = if fast {
+            let (f, zp) = mf_at_props(tyre, &fbase, mode, stiff_slip(c, steady_slip), s);
+            probe = SlipProps { re: probe.re, ..zp };
+            props = tyre_props(tyre, &probe, fz, inp.vx.abs());
+            Some(f)
+        } else {
+            None
         };
         let ctx = StepCtx {
             tyre,
@@ -758,11 +832,7 @@ impl TransientModel {
             fz,
             omega_re: inp.omega * props.re,
             floored,
-            dir: if self.config.input_mode == InputMode::Velocities && inp.vx < 0.0 {
-                -1.0
-            } else {
-                1.0
-            },
+            dir,
         };
         let mut next = self.state;
         let mut out = if fz <= FZ_OFF {
@@ -783,13 +853,11 @@ impl TransientModel {
                 ..Default::default()
             }
         } else if steady {
-            // MF convention for the steady model: κ = −Vsx/Vx with the sign
-            // of Vx (MFeval flips Fx for Vx < 0 itself).
-            let mut sl = Slip::of(&kin);
-            if self.config.input_mode == InputMode::Velocities && inp.vx < 0.0 {
-                sl.kappa = -sl.kappa;
-            }
-            self.output(&ctx, &mf_at(tyre, &fbase, mode, ctx.stiff(sl), s), sl)
+            let f = match solved {
+                Some(f) => f,
+                None => mf_at(tyre, &fbase, mode, ctx.stiff(steady_slip), s),
+            };
+            self.output(&ctx, &f, steady_slip)
         } else {
             match self.config.kind {
                 TransientKind::Relaxation => {

@@ -54,7 +54,7 @@ pub mod extras;
 pub mod limits;
 pub mod real;
 
-pub use equations::{Form, Model, Solution};
+pub use equations::{Form, LoadTerms, Model, Solution};
 pub use limits::{Clamped, Conditions};
 pub use real::Real;
 
@@ -438,8 +438,31 @@ impl Tyre {
     /// (see [`Tyre::evaluate_mu`]); `mu_scale = 1` is bit-identical.
     #[inline]
     pub fn forces_mu(&self, inp: &MfInput, mode: UseMode, mu_scale: f64) -> Forces {
+        self.forces_parts(inp, mode, mu_scale, true)
+    }
+
+    /// [`Tyre::forces_mu`] with My only when `my` (NaN otherwise,
+    /// [`Model::solve_parts`]); the other fields bit-identical.
+    /// Allocation-free.
+    #[inline]
+    pub fn forces_parts(&self, inp: &MfInput, mode: UseMode, mu_scale: f64, my: bool) -> Forces {
+        self.forces_with(inp, mode, mu_scale, my, None)
+    }
+
+    /// [`Tyre::forces_parts`] reusing the slip-independent terms of this
+    /// step's probe ([`Tyre::slip_properties_terms`], [`LoadTerms`]; used only
+    /// where they belong to the same Fz, p, γ; the same bits either way).
+    #[inline]
+    pub fn forces_with(
+        &self,
+        inp: &MfInput,
+        mode: UseMode,
+        mu_scale: f64,
+        my: bool,
+        pre: Option<&LoadTerms<f64>>,
+    ) -> Forces {
         let (c, _) = self.conditions(inp, mode);
-        let s = self.model.solve_mu(&c, mu_scale);
+        let s = self.model.solve_with(&c, mu_scale, my, pre);
         Forces {
             fx: s.fx,
             fy: s.fy,
@@ -454,8 +477,21 @@ impl Tyre {
     /// Allocation-free.
     #[inline]
     pub fn forces_xy_mu(&self, inp: &MfInput, mode: UseMode, mu_scale: f64) -> (f64, f64) {
+        self.forces_xy_with(inp, mode, mu_scale, None)
+    }
+
+    /// [`Tyre::forces_xy_mu`] with the step's [`LoadTerms`] (see
+    /// [`Tyre::forces_with`]; the same bits).
+    #[inline]
+    pub fn forces_xy_with(
+        &self,
+        inp: &MfInput,
+        mode: UseMode,
+        mu_scale: f64,
+        pre: Option<&LoadTerms<f64>>,
+    ) -> (f64, f64) {
         let (c, _) = self.conditions(inp, mode);
-        self.model.solve_fxfy(&c, mu_scale)
+        self.model.solve_fxfy_with(&c, mu_scale, pre)
     }
 
     /// The zero-slip properties the transient models need each step,
@@ -480,16 +516,32 @@ impl Tyre {
         forces: bool,
         my: bool,
     ) -> SlipProps {
+        self.slip_properties_terms(inp, mode, mu_scale, forces, my)
+            .0
+    }
+
+    /// [`Tyre::slip_properties_parts`] plus the slip-independent terms it
+    /// computed ([`LoadTerms`]), for the step's later evaluations
+    /// ([`Tyre::forces_with`], [`Tyre::forces_xy_with`]).
+    pub fn slip_properties_terms(
+        &self,
+        inp: &MfInput,
+        mode: UseMode,
+        mu_scale: f64,
+        forces: bool,
+        my: bool,
+    ) -> (SlipProps, LoadTerms<f64>) {
         let zero = MfInput {
             kappa: 0.0,
             alpha: 0.0,
             ..*inp
         };
         let (c, _, [re, _, _]) = self.conditions_radius(&zero, mode);
-        let [mux, muy, kxk, kya, fx, fy, my] = self.model.zero_slip_parts(&c, mu_scale, forces, my);
+        let ([mux, muy, kxk, kya, fx, fy, my], terms) =
+            self.model.zero_slip_terms(&c, mu_scale, forces, my);
         let is52 = self.model.form != Form::Mf6;
         let (cx, cy, sigmax, sigmay) = extras::relaxation(&self.params.p, is52, &c, kxk, kya);
-        SlipProps {
+        let props = SlipProps {
             re,
             cx,
             cy,
@@ -503,7 +555,8 @@ impl Tyre {
             fy,
             my,
             gamma: c.gamma_u,
-        }
+        };
+        (props, terms)
     }
 
     /// Re of [`Tyre::slip_properties_mu`] alone (bit-identical: the same
@@ -671,5 +724,70 @@ mod tests {
             }
         }
         assert!(n >= 5 * 1440, "{n} cases");
+    }
+
+    /// [`LoadTerms`] change nothing but the cost: the evaluations that reuse
+    /// the probe's terms give the same bits as those that compute them, and
+    /// terms of another load, pressure, camber or friction scale are not
+    /// used (the same bits again, not the other load's numbers). With turn
+    /// slip too (the terms exclude ζ1, ζ3, which depend on the slip).
+    #[test]
+    fn load_terms_are_bit_neutral() {
+        let tyre = Tyre::builtin();
+        let bits = |x: f64| if x.is_nan() { u64::MAX } else { x.to_bits() };
+        let mut used = 0;
+        for code in [111, 112, 211, 221] {
+            let mode = UseMode::from_code(code).unwrap();
+            for (fz, gamma, p) in [(4000.0, 0.0, 0.0), (2500.0, 0.04, 1.9e5), (0.0, 0.0, 0.0)] {
+                let base = MfInput {
+                    fz,
+                    gamma,
+                    p,
+                    vx: 12.0,
+                    omega: 40.0,
+                    phit: 0.01,
+                    ..Default::default()
+                };
+                let (_, own) = tyre.slip_properties_terms(&base, mode, 1.0, true, true);
+                let other = MfInput {
+                    fz: fz + 700.0,
+                    gamma: gamma + 0.01,
+                    ..base
+                };
+                let (_, foreign) = tyre.slip_properties_terms(&other, mode, 1.0, true, true);
+                for (kappa, alpha) in [(0.0, 0.0), (0.08, -0.05), (-0.5, 0.4)] {
+                    let inp = MfInput {
+                        kappa,
+                        alpha,
+                        ..base
+                    };
+                    let want = tyre.forces_parts(&inp, mode, 1.0, false);
+                    let want_xy = tyre.forces_xy_mu(&inp, mode, 1.0);
+                    for pre in [&own, &foreign] {
+                        let got = tyre.forces_with(&inp, mode, 1.0, false, Some(pre));
+                        for (a, b) in [
+                            (got.fx, want.fx),
+                            (got.fy, want.fy),
+                            (got.mx, want.mx),
+                            (got.my, want.my),
+                            (got.mz, want.mz),
+                        ] {
+                            assert_eq!(bits(a), bits(b), "mode {code} {inp:?}");
+                        }
+                        let xy = tyre.forces_xy_with(&inp, mode, 1.0, Some(pre));
+                        assert_eq!(bits(xy.0), bits(want_xy.0));
+                        assert_eq!(bits(xy.1), bits(want_xy.1));
+                        used += 1;
+                    }
+                    // Another friction scale: not the same terms.
+                    let mu = tyre.forces_with(&inp, mode, 0.6, false, Some(&own));
+                    assert_eq!(
+                        bits(mu.fy),
+                        bits(tyre.forces_parts(&inp, mode, 0.6, false).fy)
+                    );
+                }
+            }
+        }
+        assert_eq!(used, 72);
     }
 }

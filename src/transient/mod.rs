@@ -26,7 +26,7 @@
 //! 0–300 km/h and standstill sliding.
 //!
 //! # Magic Formula calls (per step)
-//! 1. [`Tyre::slip_properties_parts`] at zero slip and the actual speed (the
+//! 1. [`Tyre::slip_properties_terms`] at zero slip and the actual speed (the
 //!    "probe", the pure-slip equations only): Re, μx, μy, Cx, Cy, Kxκ, Kyα,
 //!    σκ, σα (slip-independent); Fx, Fy at zero slip only where they are used
 //!    (below VXLOW, LuGre), and My (rolling resistance with the MF's own
@@ -45,6 +45,10 @@
 //!    [`Tyre::forces_xy_mu`], as LuGre's cross terms and the non-linear slopes), so that
 //!    the MF's force at zero slip (shifts, camber thrust) keeps the MF's own
 //!    low-speed reduction (`StepCtx::offset_correction`).
+//!
+//! The evaluations after the probe reuse its slip-independent terms (μx,
+//! Kxκ, the load shape of Kyα: [`LoadTerms`], same bits), and the transient
+//! models' force evaluation skips My (taken from the probe).
 //!
 //! `mu_scale` is applied by the similarity method ([`mf_at`]) until the MF
 //! takes a friction scale itself.
@@ -67,7 +71,7 @@ pub mod scenario;
 
 pub use lugre::{LuGreFriction, LuGreParams};
 
-use crate::mf::{Forces, MfInput, SlipProps, Tyre, UseMode};
+use crate::mf::{Forces, LoadTerms, MfInput, SlipProps, Tyre, UseMode};
 use crate::tir::MfVersion;
 
 /// Which dynamics sit between the wheel's motion and the Magic Formula.
@@ -476,6 +480,22 @@ pub fn mf_at(tyre: &Tyre, base: &MfInput, mode: UseMode, slip: Slip, s: f64) -> 
     similar_forces(tyre.forces(&similar_input(base, slip, s), mode), s)
 }
 
+/// [`mf_at`] without My (NaN; [`Tyre::forces_with`]) and with the step's
+/// [`LoadTerms`] (the same bits): the transient models take My from the
+/// zero-slip probe.
+#[inline]
+fn mf_at_no_my(
+    tyre: &Tyre,
+    base: &MfInput,
+    mode: UseMode,
+    slip: Slip,
+    s: f64,
+    pre: Option<&LoadTerms<f64>>,
+) -> Forces {
+    let f = tyre.forces_with(&similar_input(base, slip, s), mode, 1.0, false, pre);
+    similar_forces(f, s)
+}
+
 /// [`mf_at`] plus the slip-independent properties of the same evaluation
 /// ([`Tyre::forces_and_props`]; at the MF's own friction, as the probe).
 #[inline]
@@ -506,7 +526,20 @@ fn similar_forces(mut o: Forces, s: f64) -> Forces {
 /// equations ([`Tyre::forces_xy_mu`]).
 #[inline]
 pub fn mf_at_xy(tyre: &Tyre, base: &MfInput, mode: UseMode, slip: Slip, s: f64) -> (f64, f64) {
-    let (fx, fy) = tyre.forces_xy_mu(&similar_input(base, slip, s), mode, 1.0);
+    mf_at_xy_with(tyre, base, mode, slip, s, None)
+}
+
+/// [`mf_at_xy`] with the step's [`LoadTerms`] (the same bits).
+#[inline]
+fn mf_at_xy_with(
+    tyre: &Tyre,
+    base: &MfInput,
+    mode: UseMode,
+    slip: Slip,
+    s: f64,
+    pre: Option<&LoadTerms<f64>>,
+) -> (f64, f64) {
+    let (fx, fy) = tyre.forces_xy_with(&similar_input(base, slip, s), mode, 1.0, pre);
     if s != 1.0 {
         (fx * s, fy * s)
     } else {
@@ -635,6 +668,9 @@ pub(crate) struct StepCtx<'a> {
     pub omega_re: f64,
     /// Whether the force evaluation runs at a raised speed (|Vx| < VXLOW).
     pub floored: bool,
+    /// The probe's slip-independent MF terms, for the step's later
+    /// evaluations at the same load ([`LoadTerms`]; None: computed afresh).
+    pub terms: Option<LoadTerms<f64>>,
     /// −1 reversing from velocities, else +1: maps the transient models'
     /// κ = −Vsx/|Vx| to the MF's κ = −Vsx/Vx (see [`StepCtx::forces`]).
     pub dir: f64,
@@ -647,16 +683,19 @@ impl StepCtx<'_> {
     /// that braking while reversing uses the braking branch of the curve (the
     /// MF's brake/drive asymmetry, SHx, SVx) with Fx mirrored by the MF
     /// (Pacejka 3rd ed. eq. 4.E9 with MFeval's sign of Vx), and the backward
-    /// conventions of Fy (α* modes), My and Mz are the MF's own: a settled
+    /// conventions of Fy (α* modes) and Mz are the MF's own: a settled
     /// transient model equals the steady one in reverse too
-    /// (tests/transient_reverse.rs).
+    /// (tests/transient_reverse.rs). My is not evaluated here (NaN): the
+    /// step takes it from the zero-slip probe (rolling resistance at the
+    /// actual speed).
     #[inline]
     pub fn forces(&self, base: &MfInput, sl: Slip) -> Forces {
         let sl = Slip {
             kappa: self.dir * sl.kappa,
             ..sl
         };
-        mf_at(self.tyre, base, self.mode, self.stiff(sl), self.s)
+        let pre = self.terms.as_ref();
+        mf_at_no_my(self.tyre, base, self.mode, self.stiff(sl), self.s, pre)
     }
 
     /// The slips scaled by the extension's slip-stiffness scale `c`
@@ -673,7 +712,8 @@ impl StepCtx<'_> {
             kappa: self.dir * sl.kappa,
             ..sl
         };
-        mf_at_xy(self.tyre, base, self.mode, self.stiff(sl), self.s)
+        let pre = self.terms.as_ref();
+        mf_at_xy_with(self.tyre, base, self.mode, self.stiff(sl), self.s, pre)
     }
 
     /// Low-speed offset correction (N): the MF's force at zero slip at the
@@ -776,7 +816,7 @@ impl TransientModel {
         // Kyα, C and σ too, bit-identical to the probe's
         // ([`Tyre::forces_and_props`]), so the probe's Magic Formula is skipped.
         let fast = steady && !mode.turn_slip && fz > FZ_OFF;
-        let (mut probe, mut props) = if fast {
+        let (mut probe, mut props, terms) = if fast {
             let probe = SlipProps {
                 re: tyre.zero_slip_radius(&base, mode),
                 ..Default::default()
@@ -785,11 +825,11 @@ impl TransientModel {
                 re: rolling_radius(tyre, probe.re),
                 ..Default::default()
             };
-            (probe, props)
+            (probe, props, None)
         } else {
-            let probe = tyre.slip_properties_parts(&base, mode, 1.0, want_forces, !steady);
+            let (probe, terms) = tyre.slip_properties_terms(&base, mode, 1.0, want_forces, !steady);
             let props = tyre_props(tyre, &probe, fz, inp.vx.abs());
-            (probe, props)
+            (probe, props, Some(terms))
         };
         let kin = kinematics(self.config.input_mode, inp, props.re);
         // The extension hook (friction and slip-stiffness scales, see
@@ -833,6 +873,7 @@ impl TransientModel {
             omega_re: inp.omega * props.re,
             floored,
             dir,
+            terms,
         };
         let mut next = self.state;
         let mut out = if fz <= FZ_OFF {

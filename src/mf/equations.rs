@@ -894,7 +894,7 @@ impl<T: Real> Model<T> {
                     * zeta0)
             * lmuy
             * sign(c.vx)
-            * c.alpha_star.cos()
+            * c.cos_alpha_star
             + zeta8
             - 1.0; // 4.E47
         let br = (p.qbz9 * p.lky * inv_lmuy + p.qbz10 * f.by * f.cy) * zeta6; // 4.E45

@@ -268,7 +268,7 @@ impl<T: Real> Model<T> {
             *fl |= Clamped::EX;
         }
         let bk = bx * kx;
-        let mut fx0 = dx * (cx * curved(bk, ex).atan()).sin() + svx; // 4.E9
+        let mut fx0 = dx * (cx * curved(bk, ex).arctan()).sin() + svx; // 4.E9
         if c.vx < 0.0 {
             fx0 = -fx0;
         }
@@ -305,7 +305,7 @@ impl<T: Real> Model<T> {
         if self.pky4_is_2 {
             arg * 2.0 / (arg * arg + 1.0)
         } else {
-            (p.pky4 * arg.atan()).sin()
+            (p.pky4 * arg.arctan()).sin()
         }
     }
 
@@ -365,7 +365,7 @@ impl<T: Real> Model<T> {
         let kyg0 = if self.is52() {
             // MF-Tyre 5.2: camber stiffness from PHY3 and PVY3/4.
             let kya0 =
-                p.pky1 * self.fz0p * (p.pky4 * (fz / (p.pky2 * self.fz0p)).atan()).sin() * p.lkyc;
+                p.pky1 * self.fz0p * (p.pky4 * (fz / (p.pky2 * self.fz0p)).arctan()).sin() * p.lkyc;
             (p.phy3 * kya0 + fz * (p.pvy3 + p.pvy4 * dfz)) * p.lkyc
         } else {
             fz * (p.pky6 + p.pky7 * dfz) * (p.ppy5 * dpi + 1.0) * p.lkyc // 4.E30
@@ -384,7 +384,7 @@ impl<T: Real> Model<T> {
                 let kyrp0 = kyg0 / (-s.eps_g + 1.0); // 4.89
                 let bhyp = kyrp0 / (chyp * dhyp * kya0_p); // 4.88
                 let x = bhyp * r0 * s.phi;
-                let shyp = dhyp * (chyp * curved(x, ehyp).atan()).sin() * sign(c.vx); // 4.80
+                let shyp = dhyp * (chyp * curved(x, ehyp).arctan()).sin() * sign(c.vx); // 4.80
                 (T::c(0.0), shyp + 1.0 - svyg / kya_p) // 4.83, 4.84
             }
             None => (one, one),
@@ -416,7 +416,7 @@ impl<T: Real> Model<T> {
         }
         let by = kya / (cy * dy + EPS * sign1(dy)); // 4.E26
         let mut fy0 = if force {
-            dy * (cy * curved(by * ay, ey).atan()).sin() + svy // 4.E19
+            dy * (cy * curved(by * ay, ey).arctan()).sin() + svy // 4.E19
         } else {
             T::c(f64::NAN)
         };
@@ -449,7 +449,7 @@ impl<T: Real> Model<T> {
         let svyk = if !T::TRACKS_DERIVATIVES && dvyk.v() == 0.0 {
             T::c(0.0) // value-only: no κ-induced side force
         } else {
-            dvyk * (p.rvy5 * (p.rvy6 * c.kappa).atan()).sin() * p.lvyka * c.smooth
+            dvyk * (p.rvy5 * (p.rvy6 * c.kappa).arctan()).sin() * p.lvyka * c.smooth
             // 4.E66
         };
         let shyk = p.rhy1 + p.rhy2 * dfz; // 4.E65
@@ -510,13 +510,13 @@ impl<T: Real> Model<T> {
             T::c(0.0)
         } else {
             p.qsx4
-                * (p.qsx5 * (q6 * q6).atan()).cos()
-                * (p.qsx7 * g + p.qsx8 * (p.qsx9 * fyn).atan()).sin()
+                * (p.qsx5 * (q6 * q6).arctan()).cos()
+                * (p.qsx7 * g + p.qsx8 * (p.qsx9 * fyn).arctan()).sin()
         };
         let atan_term = if self.skip_mx_atan {
             T::c(0.0)
         } else {
-            p.qsx10 * (p.qsx11 * fzn).atan() * g
+            p.qsx10 * (p.qsx11 * fzn).arctan() * g
         };
         r0 * fz
             * p.lmx
@@ -834,7 +834,7 @@ impl<T: Real> Model<T> {
         let et_shape = if !T::TRACKS_DERIVATIVES && qez45.v() == 0.0 {
             T::c(1.0) // value-only: the atan term is multiplied by 0
         } else {
-            qez45 * (2.0 / PI) * (bt * ct * alphat).atan() + 1.0
+            qez45 * (2.0 / PI) * (bt * ct * alphat).arctan() + 1.0
         };
         let et = (p.qez1 + p.qez2 * dfz + p.qez3 * dfz * dfz) * et_shape; // 4.E44
         let (et, hit) = cap_one(et, c.mode.limits);
@@ -861,8 +861,8 @@ impl<T: Real> Model<T> {
                     * (p.qdz8 * p.qdz9 * dfz + (p.qdz10 + p.qdz11 * dfz * c.gamma.abs()))
                     * p.lkzc;
                 let bdrp = kzgr0 / (cdrp * ddrp * (-s.eps_g + 1.0));
-                let drp = ddrp * (cdrp * (bdrp * r0 * c.phit).atan()).sin();
-                let mzp90 = mzp_inf * (2.0 / PI) * (p.qcrp2 * r0 * c.phit.abs()).atan() * gyk; // 4.103
+                let drp = ddrp * (cdrp * (bdrp * r0 * c.phit).arctan()).sin();
+                let mzp90 = mzp_inf * (2.0 / PI) * (p.qcrp2 * r0 * c.phit.abs()).arctan() * gyk; // 4.103
 
                 // At φt = 0 both are 0; use the limit φt → 0 of the ratio
                 // (MFeval gives 0/0 = NaN there: a deliberate difference).
@@ -903,8 +903,8 @@ impl<T: Real> Model<T> {
         // Combined-slip aligning torque (4.E71–4.E78 with paper A54–A56).
         let kr = kxk / kya_p;
         let kk2 = kr * kr * (c.kappa * c.kappa);
-        let ar_eq = (alphar.tan() * alphar.tan() + kk2).sqrt().atan() * sign(alphar); // A54
-        let at_eq = (alphat.tan() * alphat.tan() + kk2).sqrt().atan() * sign(alphat); // A55
+        let ar_eq = (alphar.tangent() * alphar.tangent() + kk2).sqrt().arctan() * sign(alphar); // A54
+        let at_eq = (alphat.tangent() * alphat.tangent() + kk2).sqrt().arctan() * sign(alphat); // A55
         let s =
             r0 * (p.ssz1 + p.ssz2 * (fy * self.inv_fnomin) + (p.ssz3 + p.ssz4 * dfz) * g_z) * p.ls; // A56
 
@@ -912,7 +912,7 @@ impl<T: Real> Model<T> {
         let mzr = if spin.is_none() {
             dr * cos_atan(br * ar_eq)
         } else {
-            dr * (cr * (br * ar_eq).atan()).cos()
+            dr * (cr * (br * ar_eq).arctan()).cos()
         } * c.smooth; // 4.E75
                       // Fy at γ = 0 (and Gyκ with the original γ*, as MFeval does to match TNO).
         let f0 = if c.gamma_star == 0.0 {
@@ -930,7 +930,7 @@ impl<T: Real> Model<T> {
         let fy_prime = gyk * f0.fy0; // 4.E74
         let bat = bt * at_eq;
         // 4.E73, multiplied by LFZO as TNO's solver does (found by MFeval).
-        let t = dt * (ct * curved(bat, et).atan()).cos() * c.cos_alpha_prime * p.lfzo * c.smooth;
+        let t = dt * (ct * curved(bat, et).arctan()).cos() * c.cos_alpha_prime * p.lfzo * c.smooth;
         let mz = if self.is52() {
             -t * (fy - svyk0) + mzr + s * fx // MF-Tyre 5.2 manual
         } else {
@@ -965,7 +965,7 @@ fn weight<T: Real>(unit_c: bool, c: T, b: T, e: T) -> T {
     if unit_c {
         cos_atan(y)
     } else {
-        (c * y.atan()).cos()
+        (c * y.arctan()).cos()
     }
 }
 
@@ -977,6 +977,6 @@ fn curved<T: Real>(bx: T, e: T) -> T {
     if !T::TRACKS_DERIVATIVES && e.v() == 0.0 {
         bx
     } else {
-        bx - e * (bx - bx.atan())
+        bx - e * (bx - bx.arctan())
     }
 }

@@ -1,7 +1,9 @@
 //! Benchmark section `transient`: nanoseconds per `TransientModel::step` (one
 //! FMU communication step's tyre work) for each transient model, beside one
-//! full Magic Formula evaluation measured in the same run (each step costs a
-//! zero-slip probe of the pure-slip equations plus one forces evaluation;
+//! full Magic Formula evaluation measured in the same run (the steady model
+//! without turn slip costs one forces evaluation plus the rolling radius; the
+//! transient models a zero-slip probe of the pure-slip equations plus one
+//! forces evaluation without My, sharing the probe's slip-independent terms;
 //! below VXLOW one Fx/Fy-only evaluation more; LuGre two more for the
 //! combined-slip cross terms; the non-linear relaxation three per slope), at
 //! 20 m/s and at 0.5 m/s (below VXLOW: offset correction, LuGre sub-steps).

@@ -303,80 +303,110 @@ impl Sim {
     /// On error nothing (model state, outputs) is changed. Allocation-free
     /// unless it fails.
     pub fn compute(&mut self, dt: f64, model: &mut TransientModel) -> Result<(), String> {
-        let r = &self.values.reals;
-        // Fast check first (no branch per input); the message only on failure.
-        let mut ok = r[real::P] >= 0.0 && r[real::MU_SCALE] >= 0.0;
-        for (slot, _) in INPUTS {
-            ok &= r[slot].is_finite();
-        }
-        if !ok {
-            return Err(input_error(r));
-        }
-        let m = self.mirror;
-        let inp = WheelInput {
-            vx: r[real::VX],
-            vy: flip(m, r[real::VY]),
-            omega: r[real::OMEGA],
-            fz: r[real::FZ],
-            gamma: flip(m, r[real::GAMMA]),
-            p: r[real::P],
-            phit: flip(m, r[real::PHIT]),
-            mu_scale: r[real::MU_SCALE],
-            kappa_in: r[real::KAPPA_IN],
-            alpha_in: flip(m, r[real::ALPHA_IN]),
-        };
-        let saved = model.state;
-        let mut out = match model.step(&self.loaded.tyre, &inp, dt) {
-            Ok(o) => o,
-            Err(e) => {
-                model.state = saved;
-                return Err(format!(
-                    "tyre model (transient = {}) refused the step: {e}",
-                    model.config.kind.name()
-                ));
-            }
-        };
-        let contact = inp.fz > 0.0;
-        if contact {
-            let mut finite = true;
-            for v in output_fields(&mut out) {
-                finite &= v.1.is_finite();
-            }
-            if !finite {
-                model.state = saved;
-                return Err(output_error(&mut out, &inp));
-            }
-        } else {
-            // Off the ground: no force, no moment; nothing undefined leaks out.
-            for (_, v) in output_fields(&mut out) {
-                if !v.is_finite() {
-                    *v = 0.0;
-                }
-            }
-            out.fx = 0.0;
-            out.fy = 0.0;
-            out.mx = 0.0;
-            out.my = 0.0;
-            out.mz = 0.0;
-        }
-        let r = &mut self.values.reals;
-        r[real::FX] = out.fx;
-        r[real::FY] = flip(m, out.fy);
-        r[real::MX] = flip(m, out.mx);
-        r[real::MY] = out.my;
-        r[real::MZ] = flip(m, out.mz);
-        r[real::KAPPA] = out.kappa;
-        r[real::ALPHA] = flip(m, out.alpha);
-        r[real::RE] = out.re;
-        r[real::MUX] = out.mux;
-        r[real::MUY] = out.muy;
-        r[real::VSX] = out.vsx;
-        r[real::VSY] = flip(m, out.vsy);
-        r[real::SIGMA_X] = out.sigma_x;
-        r[real::SIGMA_Y] = out.sigma_y;
-        self.values.booleans[boolean::CONTACT] = contact;
-        Ok(())
+        advance(&mut self.values, &self.loaded.tyre, self.mirror, model, dt)
     }
+
+    /// [`Sim::compute`] on the instance's own model (fmi2DoStep: no copy of
+    /// the model; a refused step leaves it as it was all the same).
+    pub fn step_own(&mut self, dt: f64) -> Result<(), String> {
+        advance(
+            &mut self.values,
+            &self.loaded.tyre,
+            self.mirror,
+            &mut self.model,
+            dt,
+        )
+    }
+}
+
+/// The work of [`Sim::compute`]: check the inputs, step `model`, check and
+/// store the outputs. On error neither `model` nor `values` has changed.
+fn advance(
+    values: &mut Values,
+    tyre: &Tyre,
+    m: bool,
+    model: &mut TransientModel,
+    dt: f64,
+) -> Result<(), String> {
+    let r = &values.reals;
+    // Fast check first (no branch per input); the message only on failure.
+    let mut ok = r[real::P] >= 0.0 && r[real::MU_SCALE] >= 0.0;
+    for (slot, _) in INPUTS {
+        ok &= r[slot].is_finite();
+    }
+    if !ok {
+        return Err(input_error(r));
+    }
+    let inp = WheelInput {
+        vx: r[real::VX],
+        vy: flip(m, r[real::VY]),
+        omega: r[real::OMEGA],
+        fz: r[real::FZ],
+        gamma: flip(m, r[real::GAMMA]),
+        p: r[real::P],
+        phit: flip(m, r[real::PHIT]),
+        mu_scale: r[real::MU_SCALE],
+        kappa_in: r[real::KAPPA_IN],
+        alpha_in: flip(m, r[real::ALPHA_IN]),
+    };
+    let saved = model.state;
+    let mut out = match model.step(tyre, &inp, dt) {
+        Ok(o) => o,
+        Err(e) => {
+            model.state = saved;
+            return Err(format!(
+                "tyre model (transient = {}) refused the step: {e}",
+                model.config.kind.name()
+            ));
+        }
+    };
+    let contact = inp.fz > 0.0;
+    if contact {
+        if !all_finite(&out) {
+            model.state = saved;
+            return Err(output_error(&mut out, &inp));
+        }
+    } else {
+        // Off the ground: no force, no moment; nothing undefined leaks out.
+        for (_, v) in output_fields(&mut out) {
+            if !v.is_finite() {
+                *v = 0.0;
+            }
+        }
+        out.fx = 0.0;
+        out.fy = 0.0;
+        out.mx = 0.0;
+        out.my = 0.0;
+        out.mz = 0.0;
+    }
+    let r = &mut values.reals;
+    r[real::FX] = out.fx;
+    r[real::FY] = flip(m, out.fy);
+    r[real::MX] = flip(m, out.mx);
+    r[real::MY] = out.my;
+    r[real::MZ] = flip(m, out.mz);
+    r[real::KAPPA] = out.kappa;
+    r[real::ALPHA] = flip(m, out.alpha);
+    r[real::RE] = out.re;
+    r[real::MUX] = out.mux;
+    r[real::MUY] = out.muy;
+    r[real::VSX] = out.vsx;
+    r[real::VSY] = flip(m, out.vsy);
+    r[real::SIGMA_X] = out.sigma_x;
+    r[real::SIGMA_Y] = out.sigma_y;
+    values.booleans[boolean::CONTACT] = contact;
+    Ok(())
+}
+
+/// Whether every output of a step is finite (one pass, no branch per field).
+#[inline]
+fn all_finite(o: &WheelOutput) -> bool {
+    [
+        o.fx, o.fy, o.mx, o.my, o.mz, o.kappa, o.alpha, o.re, o.mux, o.muy, o.vsx, o.vsy,
+        o.sigma_x, o.sigma_y,
+    ]
+    .iter()
+    .fold(true, |ok, x| ok & x.is_finite())
 }
 
 /// The message for refused inputs (cold path).
@@ -441,6 +471,45 @@ fn var(vr: u32, ty: VarType) -> Result<&'static VarInfo, String> {
         Some(v) if v.ty == ty => Ok(v),
         other => Err(var_error(vr, ty, other)),
     }
+}
+
+/// "No slot" in the compact value-reference tables below.
+const NO_SLOT: u8 = u8::MAX;
+
+/// valueReference → Real storage slot for the hot getters/setters, built at
+/// compile time from the generated variable table (so it cannot disagree
+/// with it): with `inputs_only`, only the Real *inputs* (the only Real
+/// variables fmi2SetReal accepts; the caller's state mask already limits
+/// when); otherwise every Real. [`NO_SLOT`] for anything else. A value
+/// reference that is not in the table (or not of the kind) takes the full
+/// checked path, which names the problem.
+const fn real_slots(inputs_only: bool) -> [u8; vars::VR_TABLE.len()] {
+    let mut t = [NO_SLOT; vars::VR_TABLE.len()];
+    let mut vr = 0;
+    while vr < t.len() {
+        let i = vars::VR_TABLE[vr] as usize;
+        if i < vars::VARIABLES.len() {
+            let v = &vars::VARIABLES[i];
+            let real = matches!(v.ty, VarType::Real);
+            let input = matches!(v.causality, Causality::Input);
+            if real && (input || !inputs_only) && v.slot < NO_SLOT as usize {
+                t[vr] = v.slot as u8;
+            }
+        }
+        vr += 1;
+    }
+    t
+}
+
+/// Real slot of each value reference (see [`real_slots`]).
+const REAL_SLOT: [u8; vars::VR_TABLE.len()] = real_slots(false);
+/// Real slot of each Real input's value reference (see [`real_slots`]).
+const REAL_INPUT_SLOT: [u8; vars::VR_TABLE.len()] = real_slots(true);
+
+/// The slot of `vr` in `table`, or [`NO_SLOT`].
+#[inline(always)]
+fn slot_in(table: &[u8], vr: u32) -> usize {
+    table.get(vr as usize).copied().unwrap_or(NO_SLOT) as usize
 }
 
 #[cold]
@@ -580,9 +649,7 @@ impl Instance {
         // stopTime is not enforced: the tyre has no end of validity in time, and
         // common masters (fmi-sim) take a last step past stopTime when the step
         // does not divide the interval.
-        let mut model = self.sim.model.clone();
-        self.sim.compute(h, &mut model)?;
-        self.sim.model = model;
+        self.sim.step_own(h)?;
         // Adopt the master's clock so that long runs do not drift.
         self.sim.time = t + h;
         Ok(())
@@ -617,19 +684,41 @@ impl Instance {
         }
     }
 
-    /// fmi2GetReal.
+    /// fmi2GetReal (one compact table look-up per value; an unknown or
+    /// non-Real reference falls back to the checked look-up for its message).
     pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> Result<(), String> {
         if self.sim.phase == Phase::InitializationMode {
             self.refresh_initial_outputs()?;
         }
+        let reals = &self.sim.values.reals;
         for (vr, o) in vrs.iter().zip(out.iter_mut()) {
-            *o = self.sim.values.reals[var(*vr, VarType::Real)?.slot];
+            *o = match reals.get(slot_in(&REAL_SLOT, *vr)) {
+                Some(x) => *x,
+                None => reals[var(*vr, VarType::Real)?.slot],
+            };
         }
         Ok(())
     }
 
-    /// fmi2SetReal: every value is checked before any is stored.
+    /// fmi2SetReal: every value is checked before any is stored. The usual
+    /// call (Real inputs, acceptable values) is checked in one branch-free
+    /// pass over a compact table; anything else takes the full checks, which
+    /// name the first problem.
     pub fn set_real(&mut self, vrs: &[u32], vals: &[f64]) -> Result<(), String> {
+        let mut ok = true;
+        for (vr, x) in vrs.iter().zip(vals) {
+            let s = slot_in(&REAL_INPUT_SLOT, *vr);
+            ok &= s != NO_SLOT as usize && input_problem(s, *x).is_none();
+        }
+        if ok {
+            let reals = &mut self.sim.values.reals;
+            for (vr, x) in vrs.iter().zip(vals) {
+                if let Some(r) = reals.get_mut(slot_in(&REAL_INPUT_SLOT, *vr)) {
+                    *r = *x;
+                }
+            }
+            return Ok(());
+        }
         for (vr, x) in vrs.iter().zip(vals) {
             let v = var(*vr, VarType::Real)?;
             self.check_settable(v)?;

@@ -79,6 +79,8 @@ pub struct Model<T: Real = f64> {
     lgaz: T,
     /// Zero-coefficient shortcuts allowed (value-only evaluation).
     skip_pkx3: bool,
+    /// QSY2 = 0: My does not depend on Fx (value-only).
+    skip_qsy2: bool,
     skip_qsy7: bool,
     skip_qsy8: bool,
     /// Mx terms with zero coefficients (value-only evaluation).
@@ -124,6 +126,41 @@ struct Spin<T> {
     eps_g: T,
 }
 
+/// The slip-independent pure-slip terms of one load, pressure and camber:
+/// μx (4.E13), Kxκ (4.E15, with its exp) and the load shape of Kyα (4.E25,
+/// its sin(PKY4·atan(…))), as [`Model::zero_slip_terms`] computed them. A
+/// transient step evaluates the MF several times at the same Fz, p, γ (its
+/// zero-slip probe, the forces, slopes, cross terms): handing these to the
+/// later evaluations ([`Model::solve_with`], [`Model::solve_fxfy_with`])
+/// computes them once per step. They carry the conditioned Fz, p, γ, γ* and
+/// friction scale they belong to and are used only where all match (else
+/// computed afresh), so results are bit-identical either way. Not a cache:
+/// built by each step's probe and dropped with it.
+#[derive(Clone, Copy, Debug)]
+pub struct LoadTerms<T> {
+    fz: f64,
+    p: f64,
+    gamma: f64,
+    gamma_star: f64,
+    mu_scale: f64,
+    mux: T,
+    kxk: T,
+    shape: T,
+}
+
+impl<T: Copy> LoadTerms<T> {
+    /// These terms, if they belong to conditions `c` and friction scale `mu_scale`.
+    #[inline(always)]
+    fn for_conditions(&self, c: &Conditions, mu_scale: f64) -> Option<Self> {
+        (self.fz == c.fz
+            && self.p == c.p
+            && self.gamma == c.gamma
+            && self.gamma_star == c.gamma_star
+            && self.mu_scale == mu_scale)
+            .then_some(*self)
+    }
+}
+
 impl<T: Real> Model<T> {
     /// Prepare the coefficients.
     pub fn new(p: MfParams<T>, form: Form) -> Model<T> {
@@ -136,6 +173,7 @@ impl<T: Real> Model<T> {
         let fz0p = p.lfzo * p.fnomin;
         let skip_pkx3 = !T::TRACKS_DERIVATIVES && p.pkx3.v() == 0.0;
         let zero = |x: T| !T::TRACKS_DERIVATIVES && x.v() == 0.0;
+        let skip_qsy2 = zero(p.qsy2);
         let skip_qsy7 = zero(p.qsy7);
         let skip_qsy8 = zero(p.qsy8);
         let skip_mx_sin = zero(p.qsx4) || (zero(p.qsx7) && zero(p.qsx8));
@@ -158,6 +196,7 @@ impl<T: Real> Model<T> {
             lgay,
             lgaz,
             skip_pkx3,
+            skip_qsy2,
             skip_qsy7,
             skip_qsy8,
             skip_mx_sin,
@@ -203,26 +242,18 @@ impl<T: Real> Model<T> {
         zeta1: T,
         gx: T,
         lmux: T,
+        known: Option<(T, T)>,
         force: bool,
         fl: &mut u32,
     ) -> (T, T, T) {
         let p = &self.p;
         let fz = T::c(c.fz);
         let cx = p.pcx1 * p.lcx; // 4.E11
-        let mut mux = (p.pdx1 + p.pdx2 * dfz)
-            * (p.ppx3 * dpi + p.ppx4 * dpi * dpi + 1.0)
-            * (-(p.pdx3 * gx * gx) + 1.0)
-            * lmux; // 4.E13
-        if c.fz == 0.0 {
-            mux = T::c(0.0);
-        }
-        let dx = mux * fz * zeta1; // 4.E12
-        let load = if self.skip_pkx3 {
-            fz * (p.pkx1 + p.pkx2 * dfz)
-        } else {
-            fz * (p.pkx1 + p.pkx2 * dfz) * (p.pkx3 * dfz).exp()
+        let (mux, kxk) = match known {
+            Some(mk) => mk,
+            None => self.mux_kxk(c, dfz, dpi, gx, lmux),
         };
-        let kxk = load * (p.ppx1 * dpi + p.ppx2 * dpi * dpi + 1.0) * p.lkx; // 4.E15
+        let dx = mux * fz * zeta1; // 4.E12
         if !force {
             return (T::c(f64::NAN), mux, kxk);
         }
@@ -237,11 +268,32 @@ impl<T: Real> Model<T> {
             *fl |= Clamped::EX;
         }
         let bk = bx * kx;
-        let mut fx0 = dx * (cx * curved(bk, ex).atan()).sin() + svx; // 4.E9
+        let mut fx0 = dx * (cx * curved(bk, ex).arctan()).sin() + svx; // 4.E9
         if c.vx < 0.0 {
             fx0 = -fx0;
         }
         (fx0, mux, kxk)
+    }
+
+    /// μx (4.E13) and Kxκ (4.E15): the slip-independent part of [`Model::fx0`].
+    #[inline(always)]
+    fn mux_kxk(&self, c: &Conditions, dfz: T, dpi: T, gx: T, lmux: T) -> (T, T) {
+        let p = &self.p;
+        let fz = T::c(c.fz);
+        let mut mux = (p.pdx1 + p.pdx2 * dfz)
+            * (p.ppx3 * dpi + p.ppx4 * dpi * dpi + 1.0)
+            * (-(p.pdx3 * gx * gx) + 1.0)
+            * lmux; // 4.E13
+        if c.fz == 0.0 {
+            mux = T::c(0.0);
+        }
+        let load = if self.skip_pkx3 {
+            fz * (p.pkx1 + p.pkx2 * dfz)
+        } else {
+            fz * (p.pkx1 + p.pkx2 * dfz) * (p.pkx3 * dfz).exp()
+        };
+        let kxk = load * (p.ppx1 * dpi + p.ppx2 * dpi * dpi + 1.0) * p.lkx; // 4.E15
+        (mux, kxk)
     }
 
     /// The load shape sin(PKY4·atan(…)) of Kyα (4.E25) at camber `gs`.
@@ -253,7 +305,7 @@ impl<T: Real> Model<T> {
         if self.pky4_is_2 {
             arg * 2.0 / (arg * arg + 1.0)
         } else {
-            (p.pky4 * arg.atan()).sin()
+            (p.pky4 * arg.arctan()).sin()
         }
     }
 
@@ -313,7 +365,7 @@ impl<T: Real> Model<T> {
         let kyg0 = if self.is52() {
             // MF-Tyre 5.2: camber stiffness from PHY3 and PVY3/4.
             let kya0 =
-                p.pky1 * self.fz0p * (p.pky4 * (fz / (p.pky2 * self.fz0p)).atan()).sin() * p.lkyc;
+                p.pky1 * self.fz0p * (p.pky4 * (fz / (p.pky2 * self.fz0p)).arctan()).sin() * p.lkyc;
             (p.phy3 * kya0 + fz * (p.pvy3 + p.pvy4 * dfz)) * p.lkyc
         } else {
             fz * (p.pky6 + p.pky7 * dfz) * (p.ppy5 * dpi + 1.0) * p.lkyc // 4.E30
@@ -332,7 +384,7 @@ impl<T: Real> Model<T> {
                 let kyrp0 = kyg0 / (-s.eps_g + 1.0); // 4.89
                 let bhyp = kyrp0 / (chyp * dhyp * kya0_p); // 4.88
                 let x = bhyp * r0 * s.phi;
-                let shyp = dhyp * (chyp * curved(x, ehyp).atan()).sin() * sign(c.vx); // 4.80
+                let shyp = dhyp * (chyp * curved(x, ehyp).arctan()).sin() * sign(c.vx); // 4.80
                 (T::c(0.0), shyp + 1.0 - svyg / kya_p) // 4.83, 4.84
             }
             None => (one, one),
@@ -364,7 +416,7 @@ impl<T: Real> Model<T> {
         }
         let by = kya / (cy * dy + EPS * sign1(dy)); // 4.E26
         let mut fy0 = if force {
-            dy * (cy * curved(by * ay, ey).atan()).sin() + svy // 4.E19
+            dy * (cy * curved(by * ay, ey).arctan()).sin() + svy // 4.E19
         } else {
             T::c(f64::NAN)
         };
@@ -397,7 +449,7 @@ impl<T: Real> Model<T> {
         let svyk = if !T::TRACKS_DERIVATIVES && dvyk.v() == 0.0 {
             T::c(0.0) // value-only: no κ-induced side force
         } else {
-            dvyk * (p.rvy5 * (p.rvy6 * c.kappa).atan()).sin() * p.lvyka * c.smooth
+            dvyk * (p.rvy5 * (p.rvy6 * c.kappa).arctan()).sin() * p.lvyka * c.smooth
             // 4.E66
         };
         let shyk = p.rhy1 + p.rhy2 * dfz; // 4.E65
@@ -458,13 +510,13 @@ impl<T: Real> Model<T> {
             T::c(0.0)
         } else {
             p.qsx4
-                * (p.qsx5 * (q6 * q6).atan()).cos()
-                * (p.qsx7 * g + p.qsx8 * (p.qsx9 * fyn).atan()).sin()
+                * (p.qsx5 * (q6 * q6).arctan()).cos()
+                * (p.qsx7 * g + p.qsx8 * (p.qsx9 * fyn).arctan()).sin()
         };
         let atan_term = if self.skip_mx_atan {
             T::c(0.0)
         } else {
-            p.qsx10 * (p.qsx11 * fzn).atan() * g
+            p.qsx10 * (p.qsx11 * fzn).arctan() * g
         };
         r0 * fz
             * p.lmx
@@ -487,8 +539,14 @@ impl<T: Real> Model<T> {
         let fz0 = p.fnomin;
         let vr = T::c(c.vx) * self.inv_longvl;
         let vr2 = vr * vr;
-        let speed =
-            p.qsy1 + p.qsy2 * (fx * self.inv_fnomin) + p.qsy3 * abs(vr) + p.qsy4 * (vr2 * vr2);
+        // With QSY2 = 0 the Fx term is exactly 0 (skipped, value-only), so
+        // that My needs no Fx then (the zero-slip probe skips its Fx0).
+        let fx_term = if self.skip_qsy2 {
+            T::c(0.0)
+        } else {
+            p.qsy2 * (fx * self.inv_fnomin)
+        };
+        let speed = p.qsy1 + fx_term + p.qsy3 * abs(vr) + p.qsy4 * (vr2 * vr2);
         let mut my = if self.is52() {
             -(p.unloaded_radius * fz * p.lmy * speed)
         } else {
@@ -533,8 +591,19 @@ impl<T: Real> Model<T> {
     /// [`Model::zero_slip`]: normalised load and pressure (4.E2a, 4.E2b),
     /// turn-slip spin and ζ1 (4.105, 4.106), Fx0 (4.E9) and Fy0 (4.E19) —
     /// the forces themselves only when `fx`/`fy` ask for them (NaN otherwise).
+    /// `pre`: the slip-independent terms of an earlier evaluation of this
+    /// step ([`LoadTerms`]), used when they belong to `c`.
     #[inline(always)]
-    fn pure(&self, c: &Conditions, mu_scale: f64, fx: bool, fy: bool, fl: &mut u32) -> Pure<T> {
+    fn pure(
+        &self,
+        c: &Conditions,
+        mu_scale: f64,
+        fx: bool,
+        fy: bool,
+        pre: Option<&LoadTerms<T>>,
+        fl: &mut u32,
+    ) -> Pure<T> {
+        let pre = pre.and_then(|t| t.for_conditions(c, mu_scale));
         let p = &self.p;
         let fz = T::c(c.fz);
         let dfz = (fz - self.fz0p) * self.inv_fz0p; // 4.E2a
@@ -553,8 +622,10 @@ impl<T: Real> Model<T> {
             }
             None => T::c(1.0),
         };
-        let (fx0, mux, kxk) = self.fx0(c, dfz, dpi, zeta1, gx, p.lmux * mu_scale, fx, fl);
-        let f = self.fy0(c, dfz, dpi, gs_y, spin, p.lmuy * mu_scale, None, fy, fl);
+        let known = pre.map(|t| (t.mux, t.kxk));
+        let (fx0, mux, kxk) = self.fx0(c, dfz, dpi, zeta1, gx, p.lmux * mu_scale, known, fx, fl);
+        let shape = pre.map(|t| t.shape);
+        let f = self.fy0(c, dfz, dpi, gs_y, spin, p.lmuy * mu_scale, shape, fy, fl);
         Pure {
             dfz,
             dpi,
@@ -583,15 +654,38 @@ impl<T: Real> Model<T> {
     /// skipped parts are the Magic Formula's sin(C·atan(…)) of 4.E9/4.E19 and
     /// the rolling-resistance powers — most of the probe's cost.
     pub fn zero_slip_parts(&self, c: &Conditions, mu_scale: f64, forces: bool, my: bool) -> [T; 7] {
+        self.zero_slip_terms(c, mu_scale, forces, my).0
+    }
+
+    /// [`Model::zero_slip_parts`] plus the slip-independent terms it
+    /// computed, for the step's later evaluations ([`LoadTerms`]).
+    pub fn zero_slip_terms(
+        &self,
+        c: &Conditions,
+        mu_scale: f64,
+        forces: bool,
+        my: bool,
+    ) -> ([T; 7], LoadTerms<T>) {
         let mut fl = 0u32;
-        // My needs Fx (its QSY2 term).
-        let r = self.pure(c, mu_scale, forces || my, forces, &mut fl);
+        // My needs Fx (its QSY2 term) unless QSY2 = 0 (value-only).
+        let fx = forces || (my && !self.skip_qsy2);
+        let r = self.pure(c, mu_scale, fx, forces, None, &mut fl);
         let my = if my {
             self.my(c, r.fx0)
         } else {
             T::c(f64::NAN)
         };
-        [r.mux, r.f.muy, r.kxk, r.f.kya, r.fx0, r.f.fy0, my]
+        let terms = LoadTerms {
+            fz: c.fz,
+            p: c.p,
+            gamma: c.gamma,
+            gamma_star: c.gamma_star,
+            mu_scale,
+            mux: r.mux,
+            kxk: r.kxk,
+            shape: r.f.shape,
+        };
+        ([r.mux, r.f.muy, r.kxk, r.f.kya, r.fx0, r.f.fy0, my], terms)
     }
 
     /// Combined-slip Fx, Fy (4.E50, 4.E58) from the pure-slip part, with the
@@ -612,8 +706,18 @@ impl<T: Real> Model<T> {
     /// [`Model::solve_mu`]'s Fx, Fy, so the same bits, at well under its cost
     /// (no Mz ingredients, no second Fy0 at γ = 0, no Mx, My).
     pub fn solve_fxfy(&self, c: &Conditions, mu_scale: f64) -> (T, T) {
+        self.solve_fxfy_with(c, mu_scale, None)
+    }
+
+    /// [`Model::solve_fxfy`] with the step's [`LoadTerms`] (same bits).
+    pub fn solve_fxfy_with(
+        &self,
+        c: &Conditions,
+        mu_scale: f64,
+        pre: Option<&LoadTerms<T>>,
+    ) -> (T, T) {
         let mut fl = 0u32;
-        let r = self.pure(c, mu_scale, true, true, &mut fl);
+        let r = self.pure(c, mu_scale, true, true, pre, &mut fl);
         let (fx, fy, _, _) = self.combined(c, &r, &mut fl);
         (fx, fy)
     }
@@ -626,7 +730,7 @@ impl<T: Real> Model<T> {
         let mut fl = 0u32;
         let (dfz, dpi) = self.load_pressure(c);
         let gx = T::c(c.gamma) * self.lgax;
-        let (fx0, _, _) = self.fx0(c, dfz, dpi, T::c(1.0), gx, self.p.lmux, true, &mut fl);
+        let (fx0, _, _) = self.fx0(c, dfz, dpi, T::c(1.0), gx, self.p.lmux, None, true, &mut fl);
         self.gxa(c, dfz, T::c(c.gamma_star) * self.lgax, &mut fl) * fx0
     }
 
@@ -673,12 +777,30 @@ impl<T: Real> Model<T> {
     /// contain λμ, so the small-slip stiffness is unchanged. `mu_scale = 1`
     /// gives bit-identical results to [`Model::solve`] (×1 is exact).
     pub fn solve_mu(&self, c: &Conditions, mu_scale: f64) -> Solution<T> {
+        self.solve_parts(c, mu_scale, true)
+    }
+
+    /// [`Model::solve_mu`] with My only when `my` (NaN otherwise; the
+    /// transient models take My from their zero-slip probe); every other
+    /// field the same bits (the same operations).
+    pub fn solve_parts(&self, c: &Conditions, mu_scale: f64, my: bool) -> Solution<T> {
+        self.solve_with(c, mu_scale, my, None)
+    }
+
+    /// [`Model::solve_parts`] with the step's [`LoadTerms`] (same bits).
+    pub fn solve_with(
+        &self,
+        c: &Conditions,
+        mu_scale: f64,
+        my: bool,
+        pre: Option<&LoadTerms<T>>,
+    ) -> Solution<T> {
         let p = &self.p;
         let lmuy = p.lmuy * mu_scale;
         let inv_lmuy = self.inv_lmuy * (1.0 / mu_scale);
         let mut fl = 0u32;
         let one = T::c(1.0);
-        let r = self.pure(c, mu_scale, true, true, &mut fl);
+        let r = self.pure(c, mu_scale, true, true, pre, &mut fl);
         let (dfz, dpi, spin, mux, kxk, f) = (r.dfz, r.dpi, r.spin, r.mux, r.kxk, r.f);
         let gs = T::c(c.gamma_star);
         let g = T::c(c.gamma);
@@ -712,7 +834,7 @@ impl<T: Real> Model<T> {
         let et_shape = if !T::TRACKS_DERIVATIVES && qez45.v() == 0.0 {
             T::c(1.0) // value-only: the atan term is multiplied by 0
         } else {
-            qez45 * (2.0 / PI) * (bt * ct * alphat).atan() + 1.0
+            qez45 * (2.0 / PI) * (bt * ct * alphat).arctan() + 1.0
         };
         let et = (p.qez1 + p.qez2 * dfz + p.qez3 * dfz * dfz) * et_shape; // 4.E44
         let (et, hit) = cap_one(et, c.mode.limits);
@@ -739,8 +861,8 @@ impl<T: Real> Model<T> {
                     * (p.qdz8 * p.qdz9 * dfz + (p.qdz10 + p.qdz11 * dfz * c.gamma.abs()))
                     * p.lkzc;
                 let bdrp = kzgr0 / (cdrp * ddrp * (-s.eps_g + 1.0));
-                let drp = ddrp * (cdrp * (bdrp * r0 * c.phit).atan()).sin();
-                let mzp90 = mzp_inf * (2.0 / PI) * (p.qcrp2 * r0 * c.phit.abs()).atan() * gyk; // 4.103
+                let drp = ddrp * (cdrp * (bdrp * r0 * c.phit).arctan()).sin();
+                let mzp90 = mzp_inf * (2.0 / PI) * (p.qcrp2 * r0 * c.phit.abs()).arctan() * gyk; // 4.103
 
                 // At φt = 0 both are 0; use the limit φt → 0 of the ratio
                 // (MFeval gives 0/0 = NaN there: a deliberate difference).
@@ -772,7 +894,7 @@ impl<T: Real> Model<T> {
                     * zeta0)
             * lmuy
             * sign(c.vx)
-            * c.alpha_star.cos()
+            * c.cos_alpha_star
             + zeta8
             - 1.0; // 4.E47
         let br = (p.qbz9 * p.lky * inv_lmuy + p.qbz10 * f.by * f.cy) * zeta6; // 4.E45
@@ -781,8 +903,8 @@ impl<T: Real> Model<T> {
         // Combined-slip aligning torque (4.E71–4.E78 with paper A54–A56).
         let kr = kxk / kya_p;
         let kk2 = kr * kr * (c.kappa * c.kappa);
-        let ar_eq = (alphar.tan() * alphar.tan() + kk2).sqrt().atan() * sign(alphar); // A54
-        let at_eq = (alphat.tan() * alphat.tan() + kk2).sqrt().atan() * sign(alphat); // A55
+        let ar_eq = (alphar.tangent() * alphar.tangent() + kk2).sqrt().arctan() * sign(alphar); // A54
+        let at_eq = (alphat.tangent() * alphat.tangent() + kk2).sqrt().arctan() * sign(alphat); // A55
         let s =
             r0 * (p.ssz1 + p.ssz2 * (fy * self.inv_fnomin) + (p.ssz3 + p.ssz4 * dfz) * g_z) * p.ls; // A56
 
@@ -790,7 +912,7 @@ impl<T: Real> Model<T> {
         let mzr = if spin.is_none() {
             dr * cos_atan(br * ar_eq)
         } else {
-            dr * (cr * (br * ar_eq).atan()).cos()
+            dr * (cr * (br * ar_eq).arctan()).cos()
         } * c.smooth; // 4.E75
                       // Fy at γ = 0 (and Gyκ with the original γ*, as MFeval does to match TNO).
         let f0 = if c.gamma_star == 0.0 {
@@ -808,7 +930,7 @@ impl<T: Real> Model<T> {
         let fy_prime = gyk * f0.fy0; // 4.E74
         let bat = bt * at_eq;
         // 4.E73, multiplied by LFZO as TNO's solver does (found by MFeval).
-        let t = dt * (ct * curved(bat, et).atan()).cos() * c.cos_alpha_prime * p.lfzo * c.smooth;
+        let t = dt * (ct * curved(bat, et).arctan()).cos() * c.cos_alpha_prime * p.lfzo * c.smooth;
         let mz = if self.is52() {
             -t * (fy - svyk0) + mzr + s * fx // MF-Tyre 5.2 manual
         } else {
@@ -816,7 +938,7 @@ impl<T: Real> Model<T> {
         };
 
         let mx = self.mx(c, dpi, fy);
-        let my = self.my(c, fx);
+        let my = if my { self.my(c, fx) } else { T::c(f64::NAN) };
         Solution {
             fx,
             fy,
@@ -843,7 +965,7 @@ fn weight<T: Real>(unit_c: bool, c: T, b: T, e: T) -> T {
     if unit_c {
         cos_atan(y)
     } else {
-        (c * y.atan()).cos()
+        (c * y.arctan()).cos()
     }
 }
 
@@ -855,6 +977,6 @@ fn curved<T: Real>(bx: T, e: T) -> T {
     if !T::TRACKS_DERIVATIVES && e.v() == 0.0 {
         bx
     } else {
-        bx - e * (bx - bx.atan())
+        bx - e * (bx - bx.arctan())
     }
 }

@@ -125,6 +125,11 @@ pub struct Conditions {
     pub gamma_u: f64,
     /// γ* (= sin γ with the α* definition, else γ).
     pub gamma_star: f64,
+    /// cos α* (the Dr of Mz, Pacejka 3rd ed. 4.E47): without the α*
+    /// definition and for |α| < π/2 it is 1/√(1 + tan²α) from the tan α
+    /// already computed (cos = 1/√(1 + tan²) there, exact up to rounding;
+    /// saves a cos per evaluation), else cos(α*).
+    pub cos_alpha_star: f64,
     /// φt after conditioning (× cos α, low-speed reduction, sign of Vx).
     pub phit: f64,
     /// Vx.
@@ -263,6 +268,11 @@ impl Conditions {
         } else {
             (alpha, gamma)
         };
+        let cos_alpha_star = if !mode.alpha_star && alpha.abs() < 0.5 * std::f64::consts::PI {
+            1.0 / (1.0 + tan_alpha * tan_alpha).sqrt()
+        } else {
+            alpha_star.cos()
+        };
         // Contact-centre speed and α′ (Pacejka eqs. 4.E6, 4.E6a), ε = 1e-6.
         let vcy = tan_alpha * vx.abs();
         let vc = (vx * vx + vcy * vcy).sqrt();
@@ -282,6 +292,7 @@ impl Conditions {
                 gamma,
                 gamma_u: inp.gamma,
                 gamma_star,
+                cos_alpha_star,
                 phit,
                 vx,
                 p: pr,

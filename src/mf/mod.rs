@@ -54,7 +54,7 @@ pub mod extras;
 pub mod limits;
 pub mod real;
 
-pub use equations::{Form, Model, Solution};
+pub use equations::{Form, LoadTerms, Model, Solution};
 pub use limits::{Clamped, Conditions};
 pub use real::Real;
 
@@ -438,8 +438,31 @@ impl Tyre {
     /// (see [`Tyre::evaluate_mu`]); `mu_scale = 1` is bit-identical.
     #[inline]
     pub fn forces_mu(&self, inp: &MfInput, mode: UseMode, mu_scale: f64) -> Forces {
+        self.forces_parts(inp, mode, mu_scale, true)
+    }
+
+    /// [`Tyre::forces_mu`] with My only when `my` (NaN otherwise,
+    /// [`Model::solve_parts`]); the other fields bit-identical.
+    /// Allocation-free.
+    #[inline]
+    pub fn forces_parts(&self, inp: &MfInput, mode: UseMode, mu_scale: f64, my: bool) -> Forces {
+        self.forces_with(inp, mode, mu_scale, my, None)
+    }
+
+    /// [`Tyre::forces_parts`] reusing the slip-independent terms of this
+    /// step's probe ([`Tyre::slip_properties_terms`], [`LoadTerms`]; used only
+    /// where they belong to the same Fz, p, γ; the same bits either way).
+    #[inline]
+    pub fn forces_with(
+        &self,
+        inp: &MfInput,
+        mode: UseMode,
+        mu_scale: f64,
+        my: bool,
+        pre: Option<&LoadTerms<f64>>,
+    ) -> Forces {
         let (c, _) = self.conditions(inp, mode);
-        let s = self.model.solve_mu(&c, mu_scale);
+        let s = self.model.solve_with(&c, mu_scale, my, pre);
         Forces {
             fx: s.fx,
             fy: s.fy,
@@ -454,8 +477,21 @@ impl Tyre {
     /// Allocation-free.
     #[inline]
     pub fn forces_xy_mu(&self, inp: &MfInput, mode: UseMode, mu_scale: f64) -> (f64, f64) {
+        self.forces_xy_with(inp, mode, mu_scale, None)
+    }
+
+    /// [`Tyre::forces_xy_mu`] with the step's [`LoadTerms`] (see
+    /// [`Tyre::forces_with`]; the same bits).
+    #[inline]
+    pub fn forces_xy_with(
+        &self,
+        inp: &MfInput,
+        mode: UseMode,
+        mu_scale: f64,
+        pre: Option<&LoadTerms<f64>>,
+    ) -> (f64, f64) {
         let (c, _) = self.conditions(inp, mode);
-        self.model.solve_fxfy(&c, mu_scale)
+        self.model.solve_fxfy_with(&c, mu_scale, pre)
     }
 
     /// The zero-slip properties the transient models need each step,
@@ -480,16 +516,32 @@ impl Tyre {
         forces: bool,
         my: bool,
     ) -> SlipProps {
+        self.slip_properties_terms(inp, mode, mu_scale, forces, my)
+            .0
+    }
+
+    /// [`Tyre::slip_properties_parts`] plus the slip-independent terms it
+    /// computed ([`LoadTerms`]), for the step's later evaluations
+    /// ([`Tyre::forces_with`], [`Tyre::forces_xy_with`]).
+    pub fn slip_properties_terms(
+        &self,
+        inp: &MfInput,
+        mode: UseMode,
+        mu_scale: f64,
+        forces: bool,
+        my: bool,
+    ) -> (SlipProps, LoadTerms<f64>) {
         let zero = MfInput {
             kappa: 0.0,
             alpha: 0.0,
             ..*inp
         };
         let (c, _, [re, _, _]) = self.conditions_radius(&zero, mode);
-        let [mux, muy, kxk, kya, fx, fy, my] = self.model.zero_slip_parts(&c, mu_scale, forces, my);
+        let ([mux, muy, kxk, kya, fx, fy, my], terms) =
+            self.model.zero_slip_terms(&c, mu_scale, forces, my);
         let is52 = self.model.form != Form::Mf6;
         let (cx, cy, sigmax, sigmay) = extras::relaxation(&self.params.p, is52, &c, kxk, kya);
-        SlipProps {
+        let props = SlipProps {
             re,
             cx,
             cy,
@@ -503,7 +555,67 @@ impl Tyre {
             fy,
             my,
             gamma: c.gamma_u,
-        }
+        };
+        (props, terms)
+    }
+
+    /// Re of [`Tyre::slip_properties_mu`] alone (bit-identical: the same
+    /// conditioning at κ = α = 0 and the same radius iteration), without the
+    /// Magic Formula. For the steady transient step, which takes the other
+    /// zero-slip properties from its force evaluation
+    /// ([`Tyre::forces_and_props`]).
+    pub fn zero_slip_radius(&self, inp: &MfInput, mode: UseMode) -> f64 {
+        let zero = MfInput {
+            kappa: 0.0,
+            alpha: 0.0,
+            ..*inp
+        };
+        self.conditions_radius(&zero, mode).2[0]
+    }
+
+    /// [`Tyre::forces_mu`] and, from the same evaluation, the slip-independent
+    /// fields of [`Tyre::slip_properties_mu`] for the same input: μx, μy, Kxκ,
+    /// Kyα, Cx, Cy, σx, σy and γ. Without turn slip these are bit-identical to
+    /// the zero-slip probe's: none of them depends on κ or α (Pacejka 3rd ed.
+    /// 4.E13, 4.E23, 4.E15, 4.E25 with ζ3 = 1; the carcass stiffnesses and
+    /// relaxation lengths use only Fz, p, γ), and the conditioned Fz, p, γ are
+    /// those of the probe — so one evaluation serves both. With turn slip Kyα
+    /// carries ζ3(φ), which depends on α: use the probe then. `re`, `fx`,
+    /// `fy`, `my` of the returned properties are NaN (not computed here).
+    /// Allocation-free.
+    pub fn forces_and_props(
+        &self,
+        inp: &MfInput,
+        mode: UseMode,
+        mu_scale: f64,
+    ) -> (Forces, SlipProps) {
+        let (c, _) = self.conditions(inp, mode);
+        let s = self.model.solve_mu(&c, mu_scale);
+        let is52 = self.model.form != Form::Mf6;
+        let (cx, cy, sigmax, sigmay) = extras::relaxation(&self.params.p, is52, &c, s.kxk, s.kya);
+        let forces = Forces {
+            fx: s.fx,
+            fy: s.fy,
+            mx: s.mx,
+            my: s.my,
+            mz: s.mz,
+        };
+        let props = SlipProps {
+            re: f64::NAN,
+            cx,
+            cy,
+            kxk: s.kxk,
+            kya: s.kya,
+            sigmax,
+            sigmay,
+            mux: s.mux,
+            muy: if mode.limits { s.muy.abs() } else { s.muy },
+            fx: f64::NAN,
+            fy: f64::NAN,
+            my: f64::NAN,
+            gamma: c.gamma_u,
+        };
+        (forces, props)
     }
 
     /// [`Tyre::slip_properties_mu`] with `mu_scale = 1`.
@@ -529,5 +641,153 @@ impl Tyre {
         if n > 1 {
             out[n - 1].inst_kya = out[n - 2].inst_kya;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The claim of [`Tyre::forces_and_props`]: without turn slip its
+    /// properties are the zero-slip probe's, bit for bit, and its forces are
+    /// [`Tyre::forces_mu`]'s — over slips, loads (below FZMIN, above FZMAX,
+    /// 0), pressures, cambers, speeds (reversing, below VXLOW, 0), both
+    /// limit modes and α*, for every equation family shipped in ../shared.
+    #[test]
+    fn forces_and_props_equal_the_probe_bitwise() {
+        let mut tyres = vec![Tyre::builtin()];
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/tir");
+        let mut files: Vec<_> = std::fs::read_dir(&dir)
+            .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
+            .unwrap_or_default();
+        files.sort();
+        // Files the loader refuses (deliberately broken templates) are skipped.
+        tyres.extend(files.iter().filter_map(|f| Tyre::from_file(f).ok()));
+        let forms = |f: Form| tyres.iter().filter(|t| t.model().form == f).count();
+        assert!(
+            forms(Form::Mf6) >= 2 && forms(Form::Mf52) + forms(Form::Pac2002) >= 2,
+            "expected MF 6.x and MF 5.2/PAC2002 files in {}",
+            dir.display()
+        );
+        let bits = |x: f64| if x.is_nan() { u64::MAX } else { x.to_bits() };
+        let mut n = 0;
+        for tyre in &tyres {
+            for code in [111, 121, 211, 221] {
+                let mode = UseMode::from_code(code).unwrap();
+                for fz in [0.0, 50.0, 1500.0, 4000.0, 9000.0, 40000.0] {
+                    for (kappa, alpha) in [(0.0, 0.0), (0.05, -0.1), (-0.4, 0.3), (1.5, 1.2)] {
+                        for vx in [-15.0, -0.3, 0.0, 0.5, 20.0] {
+                            for (gamma, p) in [(0.0, 0.0), (0.05, 1.8e5), (-0.1, 2.6e5)] {
+                                let inp = MfInput {
+                                    fz,
+                                    kappa,
+                                    alpha,
+                                    gamma,
+                                    vx,
+                                    p,
+                                    omega: vx / 0.3,
+                                    ..Default::default()
+                                };
+                                let (f, a) = tyre.forces_and_props(&inp, mode, 1.0);
+                                let b = tyre.slip_properties_mu(&inp, mode, 1.0);
+                                let g = tyre.forces_mu(&inp, mode, 1.0);
+                                let pairs = [
+                                    (a.mux, b.mux),
+                                    (a.muy, b.muy),
+                                    (a.kxk, b.kxk),
+                                    (a.kya, b.kya),
+                                    (a.cx, b.cx),
+                                    (a.cy, b.cy),
+                                    (a.sigmax, b.sigmax),
+                                    (a.sigmay, b.sigmay),
+                                    (a.gamma, b.gamma),
+                                    (f.fx, g.fx),
+                                    (f.fy, g.fy),
+                                    (f.mx, g.mx),
+                                    (f.my, g.my),
+                                    (f.mz, g.mz),
+                                ];
+                                for (i, (x, y)) in pairs.into_iter().enumerate() {
+                                    assert_eq!(
+                                        bits(x),
+                                        bits(y),
+                                        "{} field {i}: {x} vs {y} at {inp:?} mode {code}",
+                                        tyre.params().source
+                                    );
+                                }
+                                assert_eq!(bits(tyre.zero_slip_radius(&inp, mode)), bits(b.re));
+                                n += 1;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(n >= 5 * 1440, "{n} cases");
+    }
+
+    /// [`LoadTerms`] change nothing but the cost: the evaluations that reuse
+    /// the probe's terms give the same bits as those that compute them, and
+    /// terms of another load, pressure, camber or friction scale are not
+    /// used (the same bits again, not the other load's numbers). With turn
+    /// slip too (the terms exclude ζ1, ζ3, which depend on the slip).
+    #[test]
+    fn load_terms_are_bit_neutral() {
+        let tyre = Tyre::builtin();
+        let bits = |x: f64| if x.is_nan() { u64::MAX } else { x.to_bits() };
+        let mut used = 0;
+        for code in [111, 112, 211, 221] {
+            let mode = UseMode::from_code(code).unwrap();
+            for (fz, gamma, p) in [(4000.0, 0.0, 0.0), (2500.0, 0.04, 1.9e5), (0.0, 0.0, 0.0)] {
+                let base = MfInput {
+                    fz,
+                    gamma,
+                    p,
+                    vx: 12.0,
+                    omega: 40.0,
+                    phit: 0.01,
+                    ..Default::default()
+                };
+                let (_, own) = tyre.slip_properties_terms(&base, mode, 1.0, true, true);
+                let other = MfInput {
+                    fz: fz + 700.0,
+                    gamma: gamma + 0.01,
+                    ..base
+                };
+                let (_, foreign) = tyre.slip_properties_terms(&other, mode, 1.0, true, true);
+                for (kappa, alpha) in [(0.0, 0.0), (0.08, -0.05), (-0.5, 0.4)] {
+                    let inp = MfInput {
+                        kappa,
+                        alpha,
+                        ..base
+                    };
+                    let want = tyre.forces_parts(&inp, mode, 1.0, false);
+                    let want_xy = tyre.forces_xy_mu(&inp, mode, 1.0);
+                    for pre in [&own, &foreign] {
+                        let got = tyre.forces_with(&inp, mode, 1.0, false, Some(pre));
+                        for (a, b) in [
+                            (got.fx, want.fx),
+                            (got.fy, want.fy),
+                            (got.mx, want.mx),
+                            (got.my, want.my),
+                            (got.mz, want.mz),
+                        ] {
+                            assert_eq!(bits(a), bits(b), "mode {code} {inp:?}");
+                        }
+                        let xy = tyre.forces_xy_with(&inp, mode, 1.0, Some(pre));
+                        assert_eq!(bits(xy.0), bits(want_xy.0));
+                        assert_eq!(bits(xy.1), bits(want_xy.1));
+                        used += 1;
+                    }
+                    // Another friction scale: not the same terms.
+                    let mu = tyre.forces_with(&inp, mode, 0.6, false, Some(&own));
+                    assert_eq!(
+                        bits(mu.fy),
+                        bits(tyre.forces_parts(&inp, mode, 0.6, false).fy)
+                    );
+                }
+            }
+        }
+        assert_eq!(used, 72);
     }
 }

@@ -30,10 +30,31 @@ pub trait Real: DualNum<f64> + Copy + Send + Sync {
     fn c(x: f64) -> Self {
         Self::from(x)
     }
+    /// atan, as [`DualNum::atan`]. For `f64` it is the inherent `f64::atan`
+    /// (the same libm function, the same bits): num-dual's `f64` impl is a
+    /// separate function that the cdylib (the FMU) did not inline, an extra
+    /// call per use on the hot path.
+    #[inline(always)]
+    fn arctan(self) -> Self {
+        DualNum::atan(&self)
+    }
+    /// tan, as [`DualNum::tan`] (see [`Real::arctan`] for why).
+    #[inline(always)]
+    fn tangent(self) -> Self {
+        DualNum::tan(&self)
+    }
 }
 
 impl Real for f64 {
     const TRACKS_DERIVATIVES: bool = false;
+    #[inline(always)]
+    fn arctan(self) -> f64 {
+        f64::atan(self)
+    }
+    #[inline(always)]
+    fn tangent(self) -> f64 {
+        f64::tan(self)
+    }
 }
 
 impl<const N: usize> Real for num_dual::DualSVec64<N> {

@@ -26,11 +26,14 @@
 //! 0–300 km/h and standstill sliding.
 //!
 //! # Magic Formula calls (per step)
-//! 1. [`Tyre::slip_properties_parts`] at zero slip and the actual speed (the
+//! 1. [`Tyre::slip_properties_terms`] at zero slip and the actual speed (the
 //!    "probe", the pure-slip equations only): Re, μx, μy, Cx, Cy, Kxκ, Kyα,
 //!    σκ, σα (slip-independent); Fx, Fy at zero slip only where they are used
 //!    (below VXLOW, LuGre), and My (rolling resistance with the MF's own
-//!    low-speed/direction handling) only for the transient models.
+//!    low-speed/direction handling) only for the transient models. The
+//!    steady model without turn slip probes Re only: its force evaluation
+//!    ([`Tyre::forces_and_props`]) gives the slip-independent rest, the same
+//!    bits, so one Magic Formula evaluation per step.
 //! 2. [`Tyre::forces`] at the slips the model uses. For the transient models
 //!    the MF sees the speed sgn(Vx)·max(|Vx|, VXLOW) — they do low speed
 //!    themselves (MFeval's steady low-speed slip reduction would remove the
@@ -42,6 +45,10 @@
 //!    [`Tyre::forces_xy_mu`], as LuGre's cross terms and the non-linear slopes), so that
 //!    the MF's force at zero slip (shifts, camber thrust) keeps the MF's own
 //!    low-speed reduction (`StepCtx::offset_correction`).
+//!
+//! The evaluations after the probe reuse its slip-independent terms (μx,
+//! Kxκ, the load shape of Kyα: [`LoadTerms`], same bits), and the transient
+//! models' force evaluation skips My (taken from the probe).
 //!
 //! `mu_scale` is applied by the similarity method ([`mf_at`]) until the MF
 //! takes a friction scale itself.
@@ -64,7 +71,7 @@ pub mod scenario;
 
 pub use lugre::{LuGreFriction, LuGreParams};
 
-use crate::mf::{Forces, MfInput, SlipProps, Tyre, UseMode};
+use crate::mf::{Forces, LoadTerms, MfInput, SlipProps, Tyre, UseMode};
 use crate::tir::MfVersion;
 
 /// Which dynamics sit between the wheel's motion and the Magic Formula.
@@ -427,7 +434,7 @@ pub fn tyre_props(tyre: &Tyre, o: &SlipProps, fz: f64, vx_abs: f64) -> TyreProps
         }
     };
     TyreProps {
-        re: pos(o.re, r0),
+        re: rolling_radius(tyre, o.re),
         cx,
         cy,
         sigma_x,
@@ -448,6 +455,14 @@ pub fn tyre_props(tyre: &Tyre, o: &SlipProps, fz: f64, vx_abs: f64) -> TyreProps
     }
 }
 
+/// The effective rolling radius in use: the MF's Re when it is a positive
+/// number, else UNLOADED_RADIUS (else 0.3 m).
+#[inline]
+fn rolling_radius(tyre: &Tyre, re: f64) -> f64 {
+    let pos = |x: f64, fb: f64| if x.is_finite() && x > 0.0 { x } else { fb };
+    pos(re, pos(tyre.params().p.unloaded_radius, 0.3))
+}
+
 /// Magic Formula forces at slips (κ, tan α) on a road of friction scale `s`
 /// (the hot-path [`Tyre::forces`]; the slip-independent outputs come from the
 /// probe, see [`tyre_props`]).
@@ -462,7 +477,42 @@ pub fn tyre_props(tyre: &Tyre, o: &SlipProps, fz: f64, vx_abs: f64) -> TyreProps
 /// make this exact — see the transient report.
 #[inline]
 pub fn mf_at(tyre: &Tyre, base: &MfInput, mode: UseMode, slip: Slip, s: f64) -> Forces {
-    let mut o = tyre.forces(&similar_input(base, slip, s), mode);
+    similar_forces(tyre.forces(&similar_input(base, slip, s), mode), s)
+}
+
+/// [`mf_at`] without My (NaN; [`Tyre::forces_with`]) and with the step's
+/// [`LoadTerms`] (the same bits): the transient models take My from the
+/// zero-slip probe.
+#[inline]
+fn mf_at_no_my(
+    tyre: &Tyre,
+    base: &MfInput,
+    mode: UseMode,
+    slip: Slip,
+    s: f64,
+    pre: Option<&LoadTerms<f64>>,
+) -> Forces {
+    let f = tyre.forces_with(&similar_input(base, slip, s), mode, 1.0, false, pre);
+    similar_forces(f, s)
+}
+
+/// [`mf_at`] plus the slip-independent properties of the same evaluation
+/// ([`Tyre::forces_and_props`]; at the MF's own friction, as the probe).
+#[inline]
+fn mf_at_props(
+    tyre: &Tyre,
+    base: &MfInput,
+    mode: UseMode,
+    slip: Slip,
+    s: f64,
+) -> (Forces, SlipProps) {
+    let (f, p) = tyre.forces_and_props(&similar_input(base, slip, s), mode, 1.0);
+    (similar_forces(f, s), p)
+}
+
+/// The similarity method's force scaling of [`mf_at`] (Fx, Fy, Mx, Mz × s).
+#[inline]
+fn similar_forces(mut o: Forces, s: f64) -> Forces {
     if s != 1.0 {
         o.fx *= s;
         o.fy *= s;
@@ -476,7 +526,20 @@ pub fn mf_at(tyre: &Tyre, base: &MfInput, mode: UseMode, slip: Slip, s: f64) -> 
 /// equations ([`Tyre::forces_xy_mu`]).
 #[inline]
 pub fn mf_at_xy(tyre: &Tyre, base: &MfInput, mode: UseMode, slip: Slip, s: f64) -> (f64, f64) {
-    let (fx, fy) = tyre.forces_xy_mu(&similar_input(base, slip, s), mode, 1.0);
+    mf_at_xy_with(tyre, base, mode, slip, s, None)
+}
+
+/// [`mf_at_xy`] with the step's [`LoadTerms`] (the same bits).
+#[inline]
+fn mf_at_xy_with(
+    tyre: &Tyre,
+    base: &MfInput,
+    mode: UseMode,
+    slip: Slip,
+    s: f64,
+    pre: Option<&LoadTerms<f64>>,
+) -> (f64, f64) {
+    let (fx, fy) = tyre.forces_xy_with(&similar_input(base, slip, s), mode, 1.0, pre);
     if s != 1.0 {
         (fx * s, fy * s)
     } else {
@@ -525,6 +588,16 @@ impl Slip {
             tan_alpha: k.tan_alpha,
             alpha: k.alpha,
         }
+    }
+}
+
+/// The slips scaled by a slip-stiffness scale `c` (see [`StepCtx::stiff`]).
+#[inline]
+fn stiff_slip(c: f64, sl: Slip) -> Slip {
+    if c == 1.0 {
+        sl
+    } else {
+        Slip::new(c * sl.kappa, c * sl.tan_alpha)
     }
 }
 
@@ -595,6 +668,9 @@ pub(crate) struct StepCtx<'a> {
     pub omega_re: f64,
     /// Whether the force evaluation runs at a raised speed (|Vx| < VXLOW).
     pub floored: bool,
+    /// The probe's slip-independent MF terms, for the step's later
+    /// evaluations at the same load ([`LoadTerms`]; None: computed afresh).
+    pub terms: Option<LoadTerms<f64>>,
     /// −1 reversing from velocities, else +1: maps the transient models'
     /// κ = −Vsx/|Vx| to the MF's κ = −Vsx/Vx (see [`StepCtx::forces`]).
     pub dir: f64,
@@ -607,27 +683,26 @@ impl StepCtx<'_> {
     /// that braking while reversing uses the braking branch of the curve (the
     /// MF's brake/drive asymmetry, SHx, SVx) with Fx mirrored by the MF
     /// (Pacejka 3rd ed. eq. 4.E9 with MFeval's sign of Vx), and the backward
-    /// conventions of Fy (α* modes), My and Mz are the MF's own: a settled
+    /// conventions of Fy (α* modes) and Mz are the MF's own: a settled
     /// transient model equals the steady one in reverse too
-    /// (tests/transient_reverse.rs).
+    /// (tests/transient_reverse.rs). My is not evaluated here (NaN): the
+    /// step takes it from the zero-slip probe (rolling resistance at the
+    /// actual speed).
     #[inline]
     pub fn forces(&self, base: &MfInput, sl: Slip) -> Forces {
         let sl = Slip {
             kappa: self.dir * sl.kappa,
             ..sl
         };
-        mf_at(self.tyre, base, self.mode, self.stiff(sl), self.s)
+        let pre = self.terms.as_ref();
+        mf_at_no_my(self.tyre, base, self.mode, self.stiff(sl), self.s, pre)
     }
 
     /// The slips scaled by the extension's slip-stiffness scale `c`
     /// (similarity method: stiffness × c); unchanged when c = 1.
     #[inline]
     pub fn stiff(&self, sl: Slip) -> Slip {
-        if self.c == 1.0 {
-            sl
-        } else {
-            Slip::new(self.c * sl.kappa, self.c * sl.tan_alpha)
-        }
+        stiff_slip(self.c, sl)
     }
 
     /// Fx, Fy of [`StepCtx::forces`] only (bit-identical), without the moments.
@@ -637,7 +712,8 @@ impl StepCtx<'_> {
             kappa: self.dir * sl.kappa,
             ..sl
         };
-        mf_at_xy(self.tyre, base, self.mode, self.stiff(sl), self.s)
+        let pre = self.terms.as_ref();
+        mf_at_xy_with(self.tyre, base, self.mode, self.stiff(sl), self.s, pre)
     }
 
     /// Low-speed offset correction (N): the MF's force at zero slip at the
@@ -690,7 +766,8 @@ impl TransientModel {
     /// Advance by `dt` seconds with inputs held constant over the step and
     /// return the outputs at the end of the step. On error the state is unchanged.
     ///
-    /// Cost: one zero-slip probe (pure-slip equations, for Re, μ, the
+    /// Cost: the steady model without turn slip, one forces evaluation (and
+    /// the radius); otherwise one zero-slip probe (pure-slip equations, for Re, μ, the
     /// stiffnesses and relaxation lengths; the zero-slip forces and My only
     /// where used) and one forces-only evaluation; below VXLOW one Fx/Fy-only
     /// one more (zero-slip offsets); LuGre two Fx/Fy-only ones (cross terms);
@@ -734,8 +811,26 @@ impl TransientModel {
         // force evaluation's). The rest of `SlipProps` is always computed.
         let floored = fbase.vx != base.vx;
         let want_forces = floored || self.config.kind == TransientKind::LuGre;
-        let probe = tyre.slip_properties_parts(&base, mode, 1.0, want_forces, !steady);
-        let props = tyre_props(tyre, &probe, fz, inp.vx.abs());
+        // The steady model on the ground without turn slip needs from the
+        // probe only Re (for the slips): its force evaluation gives μ, Kxκ,
+        // Kyα, C and σ too, bit-identical to the probe's
+        // ([`Tyre::forces_and_props`]), so the probe's Magic Formula is skipped.
+        let fast = steady && !mode.turn_slip && fz > FZ_OFF;
+        let (mut probe, mut props, terms) = if fast {
+            let probe = SlipProps {
+                re: tyre.zero_slip_radius(&base, mode),
+                ..Default::default()
+            };
+            let props = TyreProps {
+                re: rolling_radius(tyre, probe.re),
+                ..Default::default()
+            };
+            (probe, props, None)
+        } else {
+            let (probe, terms) = tyre.slip_properties_terms(&base, mode, 1.0, want_forces, !steady);
+            let props = tyre_props(tyre, &probe, fz, inp.vx.abs());
+            (probe, props, Some(terms))
+        };
         let kin = kinematics(self.config.input_mode, inp, props.re);
         // The extension hook (friction and slip-stiffness scales, see
         // `extension`); a tyre without one keeps s and c = 1 untouched.
@@ -746,6 +841,25 @@ impl TransientModel {
                 (s * es, ec)
             }
             None => (s, 1.0),
+        };
+        let dir = if self.config.input_mode == InputMode::Velocities && inp.vx < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
+        // The steady model's slips: the MF convention κ = −Vsx/Vx with the
+        // sign of Vx (MFeval flips Fx for Vx < 0 itself).
+        let steady_slip = Slip {
+            kappa: dir * kin.kappa,
+            ..Slip::of(&kin)
+        };
+        let solved = if fast {
+            let (f, zp) = mf_at_props(tyre, &fbase, mode, stiff_slip(c, steady_slip), s);
+            probe = SlipProps { re: probe.re, ..zp };
+            props = tyre_props(tyre, &probe, fz, inp.vx.abs());
+            Some(f)
+        } else {
+            None
         };
         let ctx = StepCtx {
             tyre,
@@ -758,11 +872,8 @@ impl TransientModel {
             fz,
             omega_re: inp.omega * props.re,
             floored,
-            dir: if self.config.input_mode == InputMode::Velocities && inp.vx < 0.0 {
-                -1.0
-            } else {
-                1.0
-            },
+            dir,
+            terms,
         };
         let mut next = self.state;
         let mut out = if fz <= FZ_OFF {
@@ -783,13 +894,11 @@ impl TransientModel {
                 ..Default::default()
             }
         } else if steady {
-            // MF convention for the steady model: κ = −Vsx/Vx with the sign
-            // of Vx (MFeval flips Fx for Vx < 0 itself).
-            let mut sl = Slip::of(&kin);
-            if self.config.input_mode == InputMode::Velocities && inp.vx < 0.0 {
-                sl.kappa = -sl.kappa;
-            }
-            self.output(&ctx, &mf_at(tyre, &fbase, mode, ctx.stiff(sl), s), sl)
+            let f = match solved {
+                Some(f) => f,
+                None => mf_at(tyre, &fbase, mode, ctx.stiff(steady_slip), s),
+            };
+            self.output(&ctx, &f, steady_slip)
         } else {
             match self.config.kind {
                 TransientKind::Relaxation => {

@@ -35,16 +35,6 @@ const TYRES: [&str; 3] = [
 /// here that passes is reported so the list shrinks.
 const KNOWN: &[(&str, &str, &str)] = &[
     (
-        "reference_tire_tvd3.tir lugre ×1",
-        "verdict",
-        "the rig's LuGre truth on this tyre is not reproducible from its own recorded inputs (the truth replayed on them misses ~99 % of the deviation): nothing recoverable is left, the verdict is none",
-    ),
-    (
-        "reference_tire_tvd3.tir lugre ×2",
-        "verdict",
-        "as ×1",
-    ),
-    (
         "reference_tire_tvd3.tir camber ×1",
         "recovered",
         "the MF camber terms (PDY3, PKY6, PVY3, QDZ8) recover 46 % of the truth's camber-as-slip-angle + γ² friction loss on this tyre",
@@ -184,7 +174,19 @@ fn diagnose_one(
         100.0 * recovered,
         table.join(", ")
     );
-    println!("    {}", right.0.describe);
+    let ch = |e: &candidate::Evaluation| {
+        e.channels
+            .iter()
+            .map(|c| format!("{} {:+.3}", c.channel, c.oos_gain))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    println!("    {} [{}]", right.0.describe, ch(&right.0));
+    if let Some(i) = select(&ev) {
+        if ev[i].0.name != expect {
+            println!("    verdict's channels: [{}]", ch(&ev[i].0));
+        }
+    }
     Outcome {
         label: label.into(),
         verdict,

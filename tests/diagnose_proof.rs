@@ -33,18 +33,7 @@ const TYRES: [&str; 3] = [
 /// Goals known not to be met today (label, "verdict" | "recovered", why):
 /// printed, not asserted; every other case is asserted, and a case listed
 /// here that passes is reported so the list shrinks.
-const KNOWN: &[(&str, &str, &str)] = &[
-    (
-        "reference_tire_tvd3.tir camber ×1",
-        "recovered",
-        "the MF camber terms (PDY3, PKY6, PVY3, QDZ8) recover 46 % of the truth's camber-as-slip-angle + γ² friction loss on this tyre",
-    ),
-    (
-        "reference_tire_tvd3.tir camber ×2",
-        "recovered",
-        "as ×1 (44 %)",
-    ),
-];
+const KNOWN: &[(&str, &str, &str)] = &[];
 
 /// A reduced programme with the conditions `effect` acts on: three loads,
 /// drive/brake at two slip angles; three pressures only for `pressure`,

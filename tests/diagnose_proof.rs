@@ -9,8 +9,11 @@
 //! Asserted per recording: the verdict ([`candidate::select`]) names the
 //! right effect (controls: none), and the extended model recovers at least
 //! half of the held-out error gap between the baseline and the truth
-//! (the rig's noise-free forces at the recorded instants), both scored the
-//! way the diagnosis scores ([`candidate::held_out_sse`]).
+//! (the rig's noise-free forces at the recorded instants), both scored on
+//! the diagnosis' held-out half with a fixed yardstick
+//! ([`candidate::held_out_sse`]: offsets removed, each channel weighted by
+//! 1/its measured variance). Printed per recording: each candidate's pooled
+//! held-out gain/ΔBIC and the right candidate's per-channel held-out gains.
 //!
 //! `TYREKIT_PROOF_FILTER=name` restricts the run to effects whose name
 //! contains it (development aid; the full run is the proof).

@@ -41,8 +41,9 @@
 //!   1/the baseline's mean squared residual in that channel (the Gaussian
 //!   likelihood with one variance per channel, at the baseline). Only the
 //!   parameters acting on a channel with data are fitted ([`Param::channels`]:
-//!   PPX* need Fx); a fitted parameter ending at a bound is reported
-//!   ([`Fitted::at_bound`]).
+//!   PPX* need Fx), `pressure` and `camber` only when the fit half spans two
+//!   levels of pressure or inclination ([`Spec::levels`]); a fitted
+//!   parameter ending at a bound is reported ([`Fitted::at_bound`]).
 //! * Gains: per channel, the relative drop of its held-out (and fit-half)
 //!   SSE against the baseline's ([`ChannelScore`]); pooled, 1 − the
 //!   sample-weighted geometric mean of the channels' SSE ratios (the
@@ -416,6 +417,32 @@ pub struct Spec {
     /// bristle stiffnesses), where the cost is far from quadratic around the
     /// file's values. 0: no scan.
     pub prescan: usize,
+    /// A condition the parameters act through (inflation pressure,
+    /// inclination): (its value on a segment, the width of one level). The
+    /// candidate is fitted only when the fit half spans at least two levels
+    /// — at one pressure the pressure terms can only fit sensor noise on the
+    /// recorded pressure and end at a bound.
+    pub levels: Option<(fn(&crate::data::Segment) -> f64, f64)>,
+}
+
+/// Distinct levels of `levels` among the segments overlapping `mask`.
+fn level_count(
+    rec: &Recording,
+    mask: &[bool],
+    levels: (fn(&crate::data::Segment) -> f64, f64),
+) -> usize {
+    let (get, width) = levels;
+    let mut seen: Vec<i64> = rec
+        .segments
+        .iter()
+        .filter(|g| mask.get(g.start).copied().unwrap_or(false))
+        .map(get)
+        .filter(|x| x.is_finite())
+        .map(|x| (x / width).round() as i64)
+        .collect();
+    seen.sort_unstable();
+    seen.dedup();
+    seen.len()
 }
 
 fn set(p: &mut crate::tir::TyreParams, t: Target, v: f64) -> Result<()> {
@@ -597,7 +624,8 @@ impl Candidate for ParamCandidate {
         let free: Vec<usize> = (0..spec.params.len())
             .filter(|&i| spec.params[i].channels.iter().any(|&c| w[c] > 0.0))
             .collect();
-        if free.is_empty() {
+        let one_level = spec.levels.is_some_and(|l| level_count(rec, mask, l) < 2);
+        if free.is_empty() || one_level {
             return NoneCandidate.fit(rec, baseline, opts, mask, w);
         }
         let mut ro = *opts;
@@ -755,6 +783,7 @@ fn relaxation_spec(t: &Tyre, _: &ReplayOptions) -> Option<Spec> {
         sequential: true,
         kappa_re: false,
         prescan: 2,
+        levels: None,
     })
 }
 
@@ -792,6 +821,7 @@ fn lugre_spec(t: &Tyre, o: &ReplayOptions) -> Option<Spec> {
         sequential: true,
         kappa_re: false,
         prescan: 2,
+        levels: None,
     })
 }
 
@@ -809,6 +839,7 @@ fn thermal_spec(_: &Tyre, _: &ReplayOptions) -> Option<Spec> {
         sequential: true,
         kappa_re: false,
         prescan: 0,
+        levels: None,
     })
 }
 
@@ -825,6 +856,7 @@ fn load_spec(_: &Tyre, _: &ReplayOptions) -> Option<Spec> {
         sequential: false,
         kappa_re: false,
         prescan: 0,
+        levels: None,
     })
 }
 
@@ -845,6 +877,7 @@ fn pressure_spec(t: &Tyre, _: &ReplayOptions) -> Option<Spec> {
         sequential: false,
         kappa_re: false,
         prescan: 0,
+        levels: Some((|g| g.p, 5e3)),
     })
 }
 
@@ -863,6 +896,7 @@ fn speed_spec(t: &Tyre, _: &ReplayOptions) -> Option<Spec> {
         sequential: false,
         kappa_re: false,
         prescan: 0,
+        levels: None,
     })
 }
 
@@ -878,6 +912,7 @@ fn radius_spec(t: &Tyre, _: &ReplayOptions) -> Option<Spec> {
         sequential: false,
         kappa_re: true,
         prescan: 0,
+        levels: None,
     })
 }
 
@@ -913,6 +948,7 @@ fn camber_spec(t: &Tyre, _: &ReplayOptions) -> Option<Spec> {
         sequential: false,
         kappa_re: false,
         prescan: 0,
+        levels: Some((|g| g.gamma, 0.5f64.to_radians())),
     })
 }
 
@@ -1479,7 +1515,10 @@ pub fn why_not(e: &Evaluation) -> Option<String> {
         return None;
     }
     if e.n_params == 0 {
-        return Some("it has nothing to fit on the channels recorded".into());
+        return Some(
+            "it has nothing to fit: no channel it acts on is recorded, or the condition it acts through (pressure, inclination) has one level only"
+                .into(),
+        );
     }
     let (best, worst) = e.channel_range();
     let worse: Vec<String> = e
@@ -1510,4 +1549,53 @@ pub fn why_not(e: &Evaluation) -> Option<String> {
     } else {
         format!("its BIC rises ({:+.1})", e.delta_bic)
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ev(gains: &[(&'static str, f64)], pooled: f64, bic: f64) -> Evaluation {
+        Evaluation {
+            name: "x".into(),
+            n_params: 2,
+            oos_gain: pooled,
+            fit_gain: pooled,
+            delta_bic: bic,
+            channels: gains
+                .iter()
+                .map(|&(channel, g)| ChannelScore {
+                    channel,
+                    n: 1000,
+                    oos_gain: g,
+                    fit_gain: g,
+                })
+                .collect(),
+            parameters: vec![],
+            at_bound: vec![],
+            physics: String::new(),
+            describe: String::new(),
+        }
+    }
+
+    /// The real-data case of the old rule: a large gain on the badly fitted
+    /// Mz bought with a worse Fy does not name an effect, however the
+    /// pooled number and the BIC look.
+    #[test]
+    fn a_channel_made_worse_disqualifies() {
+        let e = ev(&[("FY", -0.56), ("MZ", 0.31)], 0.2, -8.0);
+        assert!(!qualifies(&e));
+        assert!(why_not(&e).unwrap().contains("Fy"));
+    }
+
+    /// An effect that lives in one channel (a rolling radius in Fx) is
+    /// named on that channel's gain; the others within the loss tolerance.
+    #[test]
+    fn one_channel_gain_names_an_effect() {
+        let e = ev(&[("FX", 0.3), ("FY", 0.0), ("MZ", -0.01)], 0.1, -10.0);
+        assert!(qualifies(&e), "{:?}", why_not(&e));
+        // Below MIN_GAIN in every channel: noise.
+        let n = ev(&[("FX", 0.03), ("FY", 0.04), ("MZ", 0.02)], 0.03, -1.0);
+        assert!(!qualifies(&n));
+    }
 }

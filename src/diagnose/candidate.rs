@@ -13,7 +13,7 @@
 //! | `lugre` | `[LUGRE]` SIGMA0X, SIGMA0Y (bristle stiffness), MUS (Stribeck ratio) | LM, replayed transient |
 //! | `thermal` | `[THERMAL]` CAPACITY (time constant with COOLING = 40 W/K, SHARE = 0.5), MU_T0..2 | LM, replayed (tread-temperature state) |
 //! | `load_sensitivity` | `[LOAD_SENSITIVITY]` MU_DFZ1, MU_DFZ2, K_DFZ1 | LM on a subsample (static) |
-//! | `pressure` | PPX1, PPX3 (with Fx data), PPY1, PPY3 (with Fy/Mz data) (MF 6.x only: MF 5.2/PAC2002 have no pressure terms) | LM, static |
+//! | `pressure` | PPX1, PPX3, PPX4 (with Fx data), PPY1, PPY3, PPY4 (with Fy/Mz data) (MF 6.x only: MF 5.2/PAC2002 have no pressure terms; needs two pressures) | LM, static |
 //! | `speed_friction` | LMUV (V0 = LONGVL) | LM, static |
 //! | `rolling_radius` | Q_RE0, FREFF (Re(Fz)); κ re-derived as (1+κ)·Re/Re_baseline − 1 | LM, static |
 //! | `camber` | PDY3, PKY6, PKY7 (PKY3, PHY3 for MF 5.2/PAC2002), PVY3, QHZ3, QDZ8, QDZ9 | LM, static |
@@ -869,8 +869,10 @@ fn pressure_spec(t: &Tyre, _: &ReplayOptions) -> Option<Spec> {
         params: vec![
             q("PPX1").on(&[FX]),
             q("PPX3").on(&[FX]),
+            q("PPX4").on(&[FX]),
             q("PPY1").on(&[FY, MZ]),
             q("PPY3").on(&[FY, MZ]),
+            q("PPY4").on(&[FY, MZ]),
         ],
         fixed: vec![],
         kind: None,
@@ -1025,20 +1027,25 @@ pub fn all() -> Vec<Box<dyn Candidate>> {
         Box::new(ParamCandidate {
             name: "pressure",
             physics: "the inflation pressure changes slip stiffness and peak friction",
-            n: 4,
+            n: 6,
             spec: pressure_spec,
             words: |f| {
                 let mut parts = Vec::new();
-                for (a, b, what) in [("PPX1", "PPX3", "Fx"), ("PPY1", "PPY3", "Fy")] {
-                    let (x, y) = (param(f, a), param(f, b));
-                    if x.is_finite() && y.is_finite() {
+                for (a, b, c, what) in [
+                    ("PPX1", "PPX3", "PPX4", "Fx"),
+                    ("PPY1", "PPY3", "PPY4", "Fy"),
+                ] {
+                    let (x, y, z) = (param(f, a), param(f, b), param(f, c));
+                    if x.is_finite() && y.is_finite() && z.is_finite() {
                         // Slip stiffness ∝ (1 + PP?1·dpi), friction ∝ (1 + PP?3·dpi)
-                        // (MF 6.1, Pacejka 3rd ed. eqs 4.E15/4.E25 and 4.E13/4.E23,
-                        // dpi = (p − p0)/p0, with PP?2, PP?4 held at 0).
+                        // (MF 6.1, Pacejka 3rd ed. eqs 4.E15/4.E25 and 4.E13/4.E23:
+                        // (1 + PP?1·dpi), (1 + PP?3·dpi + PP?4·dpi²),
+                        // dpi = (p − p0)/p0; PPX2, PPY2 held at 0).
                         parts.push(format!(
-                            "{what} slip stiffness {:+.1} % and peak friction {:+.1} % per +10 % pressure ({a} = {x:.3}, {b} = {y:.3})",
+                            "{what} slip stiffness {:+.1} % and peak friction {:+.1} % at +10 % pressure, peak friction {:+.1} % at −10 % ({a} = {x:.3}, {b} = {y:.3}, {c} = {z:.3})",
                             10.0 * x,
-                            10.0 * y
+                            10.0 * y + z,
+                            -10.0 * y + z
                         ));
                     }
                 }

@@ -291,3 +291,39 @@ fn lugre_section_round_trips_through_tir_writer() {
     let e = LuGreParams::from_tyre_params(&b).unwrap_err().to_string();
     assert!(e.contains("bad.tir") && e.contains("VS"), "{e}");
 }
+
+/// Leaving a slip for exactly zero slip: the bristle deflection relaxes over
+/// the rolled distance as it does at any small slip (θ takes its limit
+/// Fz·σ0·|Vx|/K at zero own slip; it was 0/0 → 0 and froze the last force).
+/// After 0.5 s at 15 m/s (7.5 m rolled, many relaxation lengths) the forces
+/// at κ = 0, α = 0 equal those at κ = α = 1e-12 and the MF's zero-slip force
+/// within 0.1 % of Fz.
+#[test]
+fn deflection_relaxes_at_exactly_zero_slip() {
+    let tyre = Tyre::builtin();
+    let v = 15.0;
+    let run = |k0: f64, a0: f64| {
+        let mut m = model(TransientKind::LuGre, InputMode::Slips);
+        for _ in 0..1000 {
+            m.step(&tyre, &slips(v, 0.05, 3f64.to_radians()), 1e-3)
+                .unwrap();
+        }
+        let mut out = Default::default();
+        for _ in 0..500 {
+            out = m.step(&tyre, &slips(v, k0, a0), 1e-3).unwrap();
+        }
+        let out: tyrekit::transient::WheelOutput = out;
+        out
+    };
+    let (zero, tiny) = (run(0.0, 0.0), run(1e-12, 1e-12));
+    let o = mf(&tyre, v, 0.0, 0.0);
+    for (a, b, want, n) in [
+        (zero.fx, tiny.fx, o.fx, "Fx"),
+        (zero.fy, tiny.fy, o.fy, "Fy"),
+    ] {
+        assert!(
+            (a - b).abs() <= 1e-3 * FZ && (a - want).abs() <= 1e-3 * FZ,
+            "{n}: {a} at zero slip, {b} at 1e-12, MF {want}"
+        );
+    }
+}

@@ -27,7 +27,9 @@
 //! (the selection rule decides), or call a grouping significant that
 //! [`locate`] did not.
 
-use super::candidate::{all, evaluate, select, Candidate, Evaluation, CHANNELS};
+use super::candidate::{
+    all, channels_in_words, evaluate, select, why_not, Candidate, Evaluation, CHANNELS,
+};
 use super::locate::{frictional_energy, locate, Finding, LocateOptions, Residuals};
 use super::replay::{replay, ReplayOptions};
 use crate::data::Recording;
@@ -377,23 +379,26 @@ pub fn explain(
     };
     match verdict {
         Some(e) => format!(
-            "{}. Missing from the model: {}. {} removes {:.0} % of the baseline's error on held-out segments (BIC {:+.1}).",
+            "{}. Missing from the model: {}. {} removes {:.0} % of the baseline's error on held-out segments (each channel's squared error: {}; BIC {:+.1}).{}",
             capitalise(located.as_deref().unwrap_or(
                 "no single grouping of the residual is significant on its own"
             )),
             e.physics,
             capitalise(&e.describe),
             100.0 * e.oos_gain,
-            e.delta_bic
+            channels_in_words(e),
+            e.delta_bic,
+            at_bound_note(e)
         ),
         None => {
             let best = best_other.map_or("no candidate was evaluated".to_string(), |b| {
                 format!(
-                    "the best candidate, {}, removes {:.1} % of the held-out error (BIC {:+.1}; naming an effect needs more than {:.0} % and a falling BIC)",
+                    "the best candidate, {}, removes {:.1} % of the held-out error ({}; BIC {:+.1}) and is not named: {}",
                     b.name,
                     100.0 * b.oos_gain,
+                    channels_in_words(b),
                     b.delta_bic,
-                    100.0 * MIN_GAIN
+                    why_not(b).unwrap_or_default()
                 )
             });
             match located {
@@ -408,6 +413,17 @@ pub fn explain(
             }
         }
     }
+}
+
+/// " PPY3 = -3 (its lower bound) is at a bound of its range: …", or "".
+fn at_bound_note(e: &Evaluation) -> String {
+    if e.at_bound.is_empty() {
+        return String::new();
+    }
+    format!(
+        " {} at a bound of the range the candidate allows: the data push beyond it, so that value is a limit, not an estimate.",
+        e.at_bound.join(", ")
+    )
 }
 
 /// Relative rise of a channel's held-out σ above which the verdict's
@@ -562,15 +578,27 @@ pub fn diagnose_with(
             "delta_bic": e.delta_bic,
             "n_params": e.n_params,
             "evidence": format!(
-                "{}fitted on one half of the segments, scored on the other: removes {:.1} % of the baseline's held-out squared error (BIC change {:+.1})",
+                "{}fitted on one half of the segments, scored on the other: removes {:.1} % of the baseline's held-out squared error (per channel: {}; BIC change {:+.1}){}{}",
                 if e.name == "none" {
                     String::new()
                 } else {
                     format!("{}: {}; ", e.physics, e.describe)
                 },
                 100.0 * e.oos_gain,
-                e.delta_bic
+                channels_in_words(e),
+                e.delta_bic,
+                if e.name == "none" {
+                    String::new()
+                } else {
+                    why_not(e).map_or_else(
+                        || ". Qualifies as a verdict".to_string(),
+                        |w| format!(". Not named: {w}"),
+                    )
+                },
+                at_bound_note(e)
             ),
+            "channels": e.channels,
+            "at_bound": e.at_bound,
             "parameters": params,
             "nrmse_before": before,
             "nrmse_after": nrmse_map(rec, &sim, None),

@@ -398,10 +398,29 @@ pub(crate) fn step(c: &StepCtx, p: &LuGreParams, st: &mut TransientState, dt: f6
             };
             // θ = Fz·σ0·|vr_i| / (|ΔF_i|·S); ΔF floored at 1e-9·Fz (θ then
             // just very large: z follows vr/θ ≈ 0, i.e. no slip force, as the MF says).
-            let th = |s0: f64, v: f64, f: f64| {
-                fz * s0 * v.abs() / (f.abs() * strib).max(1e-9 * fz) + transport
+            // At (numerically) zero own slip the ratio is 0/0: there θ takes
+            // its limit Fz·σ0·|Vx|/(|c·K_i|·S), K_i the MF's slip stiffness
+            // at zero slip (ΔF_i → c·K_i·slip), so that the bristles keep
+            // relaxing over the rolled distance. (θ = 0 there froze z: a
+            // sweep ending at exactly κ = 0 kept its last force for as long
+            // as κ stayed exactly 0, while κ = 1e-9 relaxed it in
+            // centimetres.) The pure-slip K_i is the limit's slope at zero
+            // slip in the other direction too; under combined slip it
+            // overestimates the slope a little (θ a little low), which only
+            // changes how fast a deflection left at zero own slip decays.
+            let vx = c.kin.vx_abs;
+            let th = |s0: f64, v: f64, f: f64, k0: f64| {
+                let k = (c.c * k0 * strib).abs();
+                if v.abs() <= 1e-9 * vx && k.is_finite() && k > 0.0 {
+                    fz * s0 * vx / k + transport
+                } else {
+                    fz * s0 * v.abs() / (f.abs() * strib).max(1e-9 * fz) + transport
+                }
             };
-            (th(s0x, vrx, o.fx - b0x), th(s0y, vry, o.fy - b0y))
+            (
+                th(s0x, vrx, o.fx - b0x, c.props.kxk),
+                th(s0y, vry, o.fy - b0y, c.props.kya),
+            )
         }
         LuGreFriction::Stribeck => {
             let g = (p.mu_c + (p.mu_s - p.mu_c) * stribeck_shape(vr, p)) * c.s;

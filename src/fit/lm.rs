@@ -241,9 +241,33 @@ fn gram_slice(
     a: &mut DMatrix<f64>,
     g: &mut DVector<f64>,
 ) {
-    const BLOCK: usize = 2048;
     a.fill(0.0);
     g.fill(0.0);
+    gram_add(data, m, k, r, a, g);
+    mirror_upper(a);
+}
+
+/// Copy the upper triangle of `a` into the lower.
+fn mirror_upper(a: &mut DMatrix<f64>) {
+    for p in 0..a.ncols() {
+        for q in 0..p {
+            a[(p, q)] = a[(q, p)];
+        }
+    }
+}
+
+/// Add JᵀJ (upper triangle only) and Jᵀr of a column-major m×k `data` to
+/// `a` and `g`, over row blocks small enough that the k column pieces stay
+/// in cache while all k(k+1)/2 products are taken.
+fn gram_add(
+    data: &[f64],
+    m: usize,
+    k: usize,
+    r: &[f64],
+    a: &mut DMatrix<f64>,
+    g: &mut DVector<f64>,
+) {
+    const BLOCK: usize = 2048;
     let mut start = 0;
     while start < m {
         let end = (start + BLOCK).min(m);
@@ -267,11 +291,109 @@ fn gram_slice(
         }
         start = end;
     }
-    for p in 0..k {
-        for q in 0..p {
-            a[(p, q)] = a[(q, p)];
+}
+
+/// Rows per chunk of the blocked linearisation ([`linearise_rows`]): fixed,
+/// not per thread, so the chunks' partial sums, added in chunk order, are
+/// the same whatever the thread count (bit-reproducible results).
+const CHUNK_ROWS: usize = 8192;
+/// Rows per Jacobian block within a chunk: a 256 × 30 block (60 kB) stays in
+/// L2 between being written and being multiplied.
+const BLOCK_ROWS: usize = 256;
+
+/// One chunk's share of the linearisation.
+struct Partial {
+    a: DMatrix<f64>,
+    g: DVector<f64>,
+    cost: f64,
+    wrss: f64,
+}
+
+/// The linearisation by row blocks of a [`RowJacobian`]: each block's r and
+/// J are computed into a small buffer, weighted by √ω (IRLS), and their
+/// upper-triangle JᵀJ and Jᵀr added to the chunk's partial; chunks are
+/// spread over `threads` scoped threads and their partials summed in chunk
+/// order. The m × k Jacobian is never stored.
+#[allow(clippy::too_many_arguments)]
+fn linearise_rows(
+    rows: &dyn super::problem::RowJacobian,
+    m: usize,
+    k: usize,
+    w: Option<&[f64]>,
+    loss: &Loss,
+    threads: usize,
+) -> (DMatrix<f64>, DVector<f64>, f64, f64) {
+    let unit = w.is_none() && loss.kind == super::loss::LossKind::Linear;
+    let n_chunks = m.div_ceil(CHUNK_ROWS).max(1);
+    let mut parts: Vec<Partial> = (0..n_chunks)
+        .map(|_| Partial {
+            a: DMatrix::zeros(k, k),
+            g: DVector::zeros(k),
+            cost: 0.0,
+            wrss: 0.0,
+        })
+        .collect();
+    let work = |c0: usize, parts: &mut [Partial]| {
+        let mut r = vec![0.0; BLOCK_ROWS];
+        let mut jac = vec![0.0; BLOCK_ROWS * k];
+        for (ci, part) in parts.iter_mut().enumerate() {
+            let chunk_start = (c0 + ci) * CHUNK_ROWS;
+            let chunk_end = (chunk_start + CHUNK_ROWS).min(m);
+            let mut b0 = chunk_start;
+            while b0 < chunk_end {
+                let nb = BLOCK_ROWS.min(chunk_end - b0);
+                let (rb, jb) = (&mut r[..nb], &mut jac[..nb * k]);
+                rows.rows(b0, rb, &mut DMatrixViewMut::from_slice(jb, nb, k));
+                for i in 0..nb {
+                    let (c, om) = loss.cost_and_weight(rb[i], w.map_or(1.0, |w| w[b0 + i]));
+                    part.cost += c;
+                    part.wrss += om * rb[i] * rb[i];
+                    if !unit {
+                        let s = om.sqrt();
+                        rb[i] *= s;
+                        for j in 0..k {
+                            jb[j * nb + i] *= s;
+                        }
+                    }
+                }
+                gram_add(jb, nb, k, rb, &mut part.a, &mut part.g);
+                b0 += nb;
+            }
         }
+    };
+    let threads = threads.clamp(1, n_chunks);
+    if threads == 1 {
+        work(0, &mut parts);
+    } else {
+        std::thread::scope(|s| {
+            let mut rest: &mut [Partial] = &mut parts;
+            let mut c0 = 0;
+            for t in 0..threads {
+                let take = (n_chunks * (t + 1)) / threads - (n_chunks * t) / threads;
+                let (mine, tail) = rest.split_at_mut(take);
+                rest = tail;
+                let work = &work;
+                let start = c0;
+                if t + 1 == threads {
+                    work(start, mine);
+                } else {
+                    s.spawn(move || work(start, mine));
+                }
+                c0 += take;
+            }
+        });
     }
+    let mut a = DMatrix::zeros(k, k);
+    let mut g = DVector::zeros(k);
+    let (mut cost, mut wrss) = (0.0, 0.0);
+    for p in &parts {
+        a += &p.a;
+        g += &p.g;
+        cost += p.cost;
+        wrss += p.wrss;
+    }
+    mirror_upper(&mut a);
+    (a, g, cost, wrss)
 }
 
 /// Robust cost of a residual vector (∞ if any residual is not finite).
@@ -284,18 +406,19 @@ fn cost_of(loss: &Loss, r: &[f64], w: Option<&[f64]>) -> f64 {
     }
 }
 
-/// Linearise `problem` at `theta` over `cols` (see [`Linearisation`]).
-pub fn linearise(
+/// The linearisation through [`Problem::jacobian`]: the whole m × k
+/// Jacobian into the workspace, then one blocked product.
+fn linearise_full(
     problem: &dyn Problem,
     theta: &[f64],
     cols: &[usize],
     loss: &Loss,
     ws: &mut Workspace,
-) -> crate::Result<Linearisation> {
+) -> (DMatrix<f64>, DVector<f64>, f64, f64) {
     let m = problem.n_residuals();
     let k = cols.len();
     if ws.r.len() != m {
-        *ws = Workspace::new(m, k);
+        *ws = Workspace::new(m, 0);
     }
     ws.ensure_cols(k);
     problem.jacobian(
@@ -312,11 +435,6 @@ pub fn linearise(
         cost += c;
         wrss += om * ws.r[i] * ws.r[i];
         ws.sw[i] = om.sqrt();
-    }
-    if !cost.is_finite() {
-        return Err(crate::Error::Numeric(
-            "fit: the residuals are not finite at the current parameters".into(),
-        ));
     }
     // Row scaling by √ω (skipped when every ω is 1: plain, unweighted LS).
     let unit = w.is_none() && loss.kind == super::loss::LossKind::Linear;
@@ -336,6 +454,29 @@ pub fn linearise(
     let mut a = DMatrix::zeros(k, k);
     let mut g = DVector::zeros(k);
     gram_slice(&ws.jac, m, k, &ws.r_trial, &mut a, &mut g);
+    (a, g, cost, wrss)
+}
+
+/// Linearise `problem` at `theta` over `cols` (see [`Linearisation`]).
+pub fn linearise(
+    problem: &dyn Problem,
+    theta: &[f64],
+    cols: &[usize],
+    loss: &Loss,
+    ws: &mut Workspace,
+) -> crate::Result<Linearisation> {
+    let m = problem.n_residuals();
+    let k = cols.len();
+    let w = problem.weights();
+    let (a, g, cost, wrss) = match problem.row_jacobian(theta, cols) {
+        Some(rows) => linearise_rows(rows.as_ref(), m, k, w, loss, problem.threads()),
+        None => linearise_full(problem, theta, cols, loss, ws),
+    };
+    if !cost.is_finite() {
+        return Err(crate::Error::Numeric(
+            "fit: the residuals are not finite at the current parameters".into(),
+        ));
+    }
     // A non-finite Jacobian entry makes its column's diagonal non-finite.
     if (0..k).any(|j| !a[(j, j)].is_finite() || !g[j].is_finite()) {
         return Err(crate::Error::Numeric(
@@ -402,7 +543,7 @@ pub fn minimize_from(
     let w = problem.weights();
     let loss = &opts.loss;
     if ws.r.len() != m {
-        *ws = Workspace::new(m, n);
+        *ws = Workspace::new(m, 0);
     }
     if n == 0 || m == 0 {
         problem.residuals(&theta, &mut ws.r);

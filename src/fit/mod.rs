@@ -33,6 +33,7 @@
 //! writes `fit.json`. Progress: pass `Some(&mut |p: &Progress| …)`.
 
 pub mod channels;
+pub mod grad_pure;
 pub mod holdout;
 pub mod identify;
 pub mod lm;
@@ -52,7 +53,7 @@ pub use identify::{IdentifyOptions, Verdict};
 pub use lm::{LmOptions, Termination};
 pub use loss::{Loss, LossKind};
 pub use metrics::{ChannelMetric, Condition};
-pub use problem::{Param, Problem, Stack};
+pub use problem::{Param, Problem, RowJacobian, Stack};
 pub use pso::PsoOptions;
 pub use recording::{simulate, RecordingProblem, SampleModel};
 pub use report::FitReport;

@@ -25,6 +25,21 @@ pub struct FitOptions {
     /// (final cost, held set, standard errors) is always the full problem's.
     #[serde(default)]
     pub coarse_first: bool,
+    /// Parameters (by name, case-insensitive) held at their start values
+    /// whatever their `free` flag: the user's hold list (`tyrekit fit
+    /// --hold`). Names the problem does not have are ignored here (a staged
+    /// fit checks them against all its stages, see `mf_fit::fit_mf`).
+    #[serde(default)]
+    pub hold: Vec<String>,
+}
+
+impl FitOptions {
+    /// Whether the hold list names parameter `name`.
+    pub fn holds(&self, name: &str) -> bool {
+        self.hold
+            .iter()
+            .any(|h| h.trim().eq_ignore_ascii_case(name))
+    }
 }
 
 /// What is happening, for a progress display.
@@ -167,6 +182,11 @@ pub fn fit_global(
         }
         None => params.iter().map(|p| p.free).collect(),
     };
+    let free_in: Vec<bool> = free_in
+        .iter()
+        .zip(params)
+        .map(|(&f, p)| f && !opts.holds(&p.name))
+        .collect();
     let n_all = params.len();
     let m = problem.n_residuals();
     let loss = opts.lm.loss;

@@ -41,14 +41,7 @@ pub struct MfFitOptions {
 impl Default for MfFitOptions {
     fn default() -> Self {
         MfFitOptions {
-            only: vec![
-                StageKind::PureFx,
-                StageKind::PureFy,
-                StageKind::Mz,
-                StageKind::Combined,
-                StageKind::Mx,
-                StageKind::My,
-            ],
+            only: StageKind::ALL.to_vec(),
             transient: false,
             holdout: Holdout::None,
             nominal_from_data: true,
@@ -160,16 +153,8 @@ pub fn widen_ranges(tyre: &mut TyreParams, recs: &[Recording]) -> crate::Result<
 /// an unknown name is an error naming it (a typo must not silently fit
 /// the coefficient it meant to hold).
 fn check_hold(hold: &[String]) -> crate::Result<()> {
-    let all = [
-        StageKind::PureFx,
-        StageKind::PureFy,
-        StageKind::Mz,
-        StageKind::Combined,
-        StageKind::Mx,
-        StageKind::My,
-    ];
     for h in hold {
-        let known = all
+        let known = StageKind::ALL
             .iter()
             .any(|k| k.table().iter().any(|e| e.0.eq_ignore_ascii_case(h.trim())));
         if !known {
@@ -233,14 +218,7 @@ pub fn fit_mf(
     };
     let mut skipped = Vec::new();
     let mut fitted_channels: Vec<(Channel, crate::data::SegmentKind)> = Vec::new();
-    for kind in [
-        StageKind::PureFx,
-        StageKind::PureFy,
-        StageKind::Mz,
-        StageKind::Combined,
-        StageKind::Mx,
-        StageKind::My,
-    ] {
+    for kind in StageKind::ALL {
         if !opts.only.contains(&kind) {
             continue;
         }

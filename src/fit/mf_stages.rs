@@ -102,6 +102,16 @@ pub enum StageKind {
 }
 
 impl StageKind {
+    /// Every stage, in the order a staged fit runs them.
+    pub const ALL: [StageKind; 6] = [
+        StageKind::PureFx,
+        StageKind::PureFy,
+        StageKind::Mz,
+        StageKind::Combined,
+        StageKind::Mx,
+        StageKind::My,
+    ];
+
     /// Parse a `--only` word (`fx`, `fy`, `mz`, `combined`).
     pub fn parse(s: &str) -> Option<StageKind> {
         match s.trim().to_ascii_lowercase().as_str() {

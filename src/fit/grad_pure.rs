@@ -60,6 +60,19 @@ pub struct Weights {
 /// The combined-slip factors of `channel` at `c` for `model` (the start
 /// tyre's: they do not depend on the pure-slip coefficients).
 pub fn weights(model: &Model<f64>, c: &Conditions, channel: Channel) -> Weights {
+    // Pure slip (κ = 0 for Fy, α* = 0 for Fx): Gyκ = cos(…SHyκ…)/cos(…SHyκ…)
+    // and Gxα likewise are exactly 1 and SVyκ ∝ sin(RVY5·atan 0) is 0, so
+    // the same values without the weighting functions' transcendentals.
+    let pure = match channel {
+        Channel::Fy => c.kappa == 0.0,
+        _ => c.alpha_star == 0.0,
+    };
+    if pure {
+        return Weights {
+            g: 1.0,
+            sv_unit: 0.0,
+        };
+    }
     let (gyk, svyk, gxa) = model.slip_weights(c);
     match channel {
         Channel::Fy => Weights {
@@ -149,9 +162,15 @@ impl PureGrad {
         let den1 = p.pky2 + p.pky5 * gs * gs;
         let den2 = p.ppy2 * dpi + 1.0;
         let arg = (fz * self.inv_fz0p) / (den1 * den2);
-        let at = arg.atan();
-        let shape = if p.pky4 == 2.0 {
-            arg * 2.0 / (arg * arg + 1.0) // Model's value-only shortcut (same bits)
+        // sin(2 atan a) = 2a/(1 + a²): Model's value-only shortcut (same bits).
+        let pky4_is_2 = p.pky4 == 2.0;
+        let at = if pky4_is_2 && grad.is_none() {
+            f64::NAN // not needed
+        } else {
+            arg.atan()
+        };
+        let shape = if pky4_is_2 {
+            arg * 2.0 / (arg * arg + 1.0)
         } else {
             (p.pky4 * at).sin()
         };
@@ -191,7 +210,13 @@ impl PureGrad {
         let ax = x.atan();
         let inner = if ey == 0.0 { x } else { x - ey * (x - ax) };
         let ai = inner.atan();
-        let s = (cy * ai).sin();
+        // sin and cos of one angle in one call when both are needed (glibc's
+        // sincos: the same values as sin, cos).
+        let (s, co) = if grad.is_some() {
+            (cy * ai).sin_cos()
+        } else {
+            ((cy * ai).sin(), f64::NAN)
+        };
         let mut fy0 = dy * s + svy; // 4.E19
         let neg = c.mode.alpha_star && c.vx < 0.0;
         if neg {
@@ -202,7 +227,6 @@ impl PureGrad {
         let Some(gr) = grad else { return fy };
 
         // Adjoints: ∂Fy/∂(intermediate).
-        let co = (cy * ai).cos();
         let f = if neg { -w.g } else { w.g };
         let f_in = f * dy * co * cy / (inner * inner + 1.0);
         let g_x = f_in * (1.0 - ey + ey / (x * x + 1.0));
@@ -225,13 +249,13 @@ impl PureGrad {
         // Kyα partials.
         let k_shape = p.pky1 * self.fz0p * ppy1_f * g3 * p.lky;
         let g_shape = g_k * k_shape;
-        let dshape_darg = if p.pky4 == 2.0 {
+        let dshape_darg = if pky4_is_2 {
             // d/da of 2a/(1 + a²) = cos(2 atan a)·2/(1 + a²)
             2.0 * (1.0 - arg * arg) / ((arg * arg + 1.0) * (arg * arg + 1.0))
         } else {
             (p.pky4 * at).cos() * p.pky4 / (arg * arg + 1.0)
         };
-        let cos_shape = if p.pky4 == 2.0 {
+        let cos_shape = if pky4_is_2 {
             (1.0 - arg * arg) / (arg * arg + 1.0)
         } else {
             (p.pky4 * at).cos()
@@ -313,7 +337,13 @@ impl PureGrad {
         let ax = x.atan();
         let inner = if ex == 0.0 { x } else { x - ex * (x - ax) };
         let ai = inner.atan();
-        let s = (cx * ai).sin();
+        // sin and cos of one angle in one call when both are needed (glibc's
+        // sincos: the same values as sin, cos).
+        let (s, co) = if grad.is_some() {
+            (cx * ai).sin_cos()
+        } else {
+            ((cx * ai).sin(), f64::NAN)
+        };
         let mut fx0 = dx * s + svx; // 4.E9
         let neg = c.vx < 0.0;
         if neg {
@@ -322,7 +352,6 @@ impl PureGrad {
         let fx = w.g * fx0; // 4.E50
         let Some(gr) = grad else { return fx };
 
-        let co = (cx * ai).cos();
         let f = if neg { -w.g } else { w.g };
         let f_in = f * dx * co * cx / (inner * inner + 1.0);
         let g_x = f_in * (1.0 - ex + ex / (x * x + 1.0));

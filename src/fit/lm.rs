@@ -114,6 +114,12 @@ pub struct LmResult {
     /// Residual evaluations (trial steps).
     pub residual_evals: usize,
     pub termination: Termination,
+    /// The last linearisation over the free columns, when it is at `theta`
+    /// or one final step of predicted gain ≤ ftol·cost away from it (the
+    /// run's last step, taken without linearising again): good for
+    /// identifiability and standard errors at the solution, and saves the
+    /// caller an evaluation of J. Its `cost` is that of its own point.
+    pub linearisation: Option<Linearisation>,
 }
 
 /// The problem linearised at θ over the columns `cols`: the weighted Gram
@@ -177,7 +183,7 @@ impl Workspace {
 
 /// Dot product with four independent accumulators (lets the compiler
 /// vectorise; the summation order is fixed, so results are reproducible).
-#[inline]
+#[inline(always)]
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     let mut acc = [0.0f64; 4];
     let ca = a.chunks_exact(4);
@@ -195,27 +201,34 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     s
 }
 
-/// Four dot products of `a` with `b[0..4]`, each with two accumulators
-/// (fixed summation order: reproducible).
-#[inline]
+/// Four dot products of `a` with `b[0..4]`, each over four interleaved
+/// accumulators (row i → accumulator i mod 4) combined as (0 + 1) + (2 + 3):
+/// a fixed summation order, so the result is reproducible and the same for
+/// whichever instruction set [`gram_add`] compiled it for.
+#[inline(always)]
 fn dot4(a: &[f64], b: [&[f64]; 4]) -> [f64; 4] {
     let n = a.len();
-    let mut acc = [[0.0f64; 2]; 4];
-    let half = n / 2 * 2;
-    let mut i = 0;
-    while i < half {
-        let (x0, x1) = (a[i], a[i + 1]);
-        for l in 0..4 {
-            acc[l][0] += x0 * b[l][i];
-            acc[l][1] += x1 * b[l][i + 1];
+    let (b0, b1, b2, b3) = (&b[0][..n], &b[1][..n], &b[2][..n], &b[3][..n]);
+    let mut acc = [[0.0f64; 4]; 4];
+    let n4 = n / 4 * 4;
+    for (((x, y0), (y1, y2)), y3) in a[..n4]
+        .chunks_exact(4)
+        .zip(b0[..n4].chunks_exact(4))
+        .zip(b1[..n4].chunks_exact(4).zip(b2[..n4].chunks_exact(4)))
+        .zip(b3[..n4].chunks_exact(4))
+    {
+        for j in 0..4 {
+            acc[0][j] += x[j] * y0[j];
+            acc[1][j] += x[j] * y1[j];
+            acc[2][j] += x[j] * y2[j];
+            acc[3][j] += x[j] * y3[j];
         }
-        i += 2;
     }
     let mut out = [0.0; 4];
     for l in 0..4 {
-        out[l] = acc[l][0] + acc[l][1];
-        if half < n {
-            out[l] += a[half] * b[l][half];
+        out[l] = (acc[l][0] + acc[l][1]) + (acc[l][2] + acc[l][3]);
+        for i in n4..n {
+            out[l] += a[i] * b[l][i];
         }
     }
     out
@@ -259,7 +272,8 @@ fn mirror_upper(a: &mut DMatrix<f64>) {
 /// Add JᵀJ (upper triangle only) and Jᵀr of a column-major m×k `data` to
 /// `a` and `g`, over row blocks small enough that the k column pieces stay
 /// in cache while all k(k+1)/2 products are taken.
-fn gram_add(
+#[inline(always)]
+fn gram_add_impl(
     data: &[f64],
     m: usize,
     k: usize,
@@ -293,13 +307,46 @@ fn gram_add(
     }
 }
 
+/// [`gram_add_impl`], compiled for AVX2 when the CPU has it (4-wide
+/// vectors instead of SSE2's 2; no FMA, and the kernels fix the summation
+/// order, so the result has the same bits either way).
+fn gram_add(
+    data: &[f64],
+    m: usize,
+    k: usize,
+    r: &[f64],
+    a: &mut DMatrix<f64>,
+    g: &mut DVector<f64>,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2 (checked just above).
+        unsafe { gram_add_avx2(data, m, k, r, a, g) };
+        return;
+    }
+    gram_add_impl(data, m, k, r, a, g)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn gram_add_avx2(
+    data: &[f64],
+    m: usize,
+    k: usize,
+    r: &[f64],
+    a: &mut DMatrix<f64>,
+    g: &mut DVector<f64>,
+) {
+    gram_add_impl(data, m, k, r, a, g)
+}
+
 /// Rows per chunk of the blocked linearisation ([`linearise_rows`]): fixed,
 /// not per thread, so the chunks' partial sums, added in chunk order, are
 /// the same whatever the thread count (bit-reproducible results).
 const CHUNK_ROWS: usize = 8192;
-/// Rows per Jacobian block within a chunk: a 256 × 30 block (60 kB) stays in
-/// L2 between being written and being multiplied.
-const BLOCK_ROWS: usize = 256;
+/// Rows per Jacobian block within a chunk: a 128 × 30 block (30 kB) stays in
+/// L1 between being written and being multiplied.
+const BLOCK_ROWS: usize = 128;
 
 /// One chunk's share of the linearisation.
 struct Partial {
@@ -555,6 +602,7 @@ pub fn minimize_from(
             iterations: 0,
             residual_evals: 1,
             termination: Termination::NoFreeParameters,
+            linearisation: None,
         });
     }
     let lower: Vec<f64> = cols.iter().map(|&c| params[c].lower).collect();
@@ -575,6 +623,10 @@ pub fn minimize_from(
     let mut mat = DMatrix::<f64>::zeros(n, n);
     let mut rhs = DVector::<f64>::zeros(n);
     let mut active = vec![false; n];
+    // Whether `lin` is at `theta` (false only after a final accepted step),
+    // or one last step of gain below ftol away from it.
+    let mut lin_at_theta = true;
+    let mut lin_near_theta = false;
 
     let termination = 'outer: loop {
         iterations += 1;
@@ -639,6 +691,13 @@ pub fn minimize_from(
             }
             // Predicted reduction of the quadratic model for s.
             let pred = -(lin.g.dot(&s) + 0.5 * s.dot(&(&lin.a * &s)));
+            // Nearly undamped (λ ≤ 1e-3: the step is the Gauss–Newton step
+            // to 0.1 %) and the model predicts a gain below ftol: θ is the
+            // minimum to that tolerance. Take this last step if it lowers the
+            // cost (one residual evaluation) and stop without linearising
+            // again: the last linearisation is one step of negligible
+            // predicted gain away, good for the caller's standard errors.
+            let last = lambda <= 1e-3 && (0.0..=opts.ftol * cost).contains(&pred);
             let mut dx = 0.0;
             let mut xn = 0.0;
             for k in 0..n {
@@ -650,9 +709,18 @@ pub fn minimize_from(
             residual_evals += 1;
             let new_cost = cost_of(loss, &ws.r_trial, w);
             let actual = cost - new_cost;
+            if last {
+                if actual > 0.0 {
+                    theta.copy_from_slice(&trial);
+                    cost = new_cost;
+                }
+                lin_near_theta = true;
+                break 'outer Termination::Cost;
+            }
             let rho = if pred > 0.0 { actual / pred } else { -1.0 };
             if rho > 1e-4 {
                 theta.copy_from_slice(&trial);
+                lin_at_theta = false;
                 let small_f = actual <= opts.ftol * cost && pred <= opts.ftol * cost;
                 cost = new_cost;
                 lambda *= (1.0f64 / 3.0).max(1.0 - (2.0 * rho - 1.0).powi(3));
@@ -670,6 +738,7 @@ pub fn minimize_from(
                     break 'outer Termination::MaxIterations;
                 }
                 lin = linearise(problem, &theta, &cols, loss, ws)?;
+                lin_at_theta = true;
                 cost = lin.cost;
                 continue 'outer;
             }
@@ -696,6 +765,7 @@ pub fn minimize_from(
         iterations,
         residual_evals,
         termination,
+        linearisation: (lin_at_theta || lin_near_theta).then_some(lin),
     })
 }
 

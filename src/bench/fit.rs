@@ -7,7 +7,7 @@
 //! the same data, start and bounds: wall time and final cost of both, ratio.
 //! The Python side first checks its model against the noise-free Fy the Rust
 //! side wrote (same parameters). The tyrekit figure is the stage as
-//! `tyrekit fit` runs it (one-channel evaluation, coarse subsample first,
+//! `tyrekit fit` runs it (closed-form gradients, J never stored, coarse subsample first,
 //! then all samples; see [`crate::fit::mf_stages::fit_stage`]), on 1 thread
 //! (the ratio to single-threaded SciPy) and on all cores.
 //! Then the whole default staged fit (Fx, Fy, Mz, combined, Mx) of a rig

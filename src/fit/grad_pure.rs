@@ -225,38 +225,41 @@ impl PureGrad {
         let muy_out = if fz == 0.0 { 0.0 } else { muy };
         let fy = w.g * fy0 + w.sv_unit * muy_out * 1.0; // 4.E58
         let Some(gr) = grad else { return fy };
+        let gr = &mut gr[..FY_KEYS.len()];
 
         // Adjoints: ∂Fy/∂(intermediate).
+        let (inv_den, inv_kp, inv_den1) = (1.0 / den, 1.0 / kp, 1.0 / den1);
+        let inv_a2 = 1.0 / (arg * arg + 1.0);
         let f = if neg { -w.g } else { w.g };
         let f_in = f * dy * co * cy / (inner * inner + 1.0);
         let g_x = f_in * (1.0 - ey + ey / (x * x + 1.0));
         let g_ey = if capped { 0.0 } else { -f_in * (x - ax) };
         let g_by = g_x * ay;
         let g_ay = g_x * by;
-        let mut g_k = g_by / den;
-        let g_dy = f * s - g_by * by * cy / den;
-        let g_cy = f * dy * co * ai - g_by * by * dy / den;
+        let mut g_k = g_by * inv_den;
+        let g_dy = f * s - g_by * by * cy * inv_den;
+        let g_cy = f * dy * co * ai - g_by * by * dy * inv_den;
         let g_muy = g_dy * fz + if fz == 0.0 { 0.0 } else { w.sv_unit };
         let g_shy = g_ay * c.smooth;
         let g_svy = f * c.smooth;
         let mut g_svyg = g_svy;
         let mut g_kyg0 = 0.0;
         if !self.is52 {
-            g_kyg0 = g_shy * gs / kp;
-            g_svyg -= g_shy / kp;
-            g_k -= g_shy * q / kp;
+            g_kyg0 = g_shy * gs * inv_kp;
+            g_svyg -= g_shy * inv_kp;
+            g_k -= g_shy * q * inv_kp;
         }
         // Kyα partials.
         let k_shape = p.pky1 * self.fz0p * ppy1_f * g3 * p.lky;
         let g_shape = g_k * k_shape;
         let dshape_darg = if pky4_is_2 {
             // d/da of 2a/(1 + a²) = cos(2 atan a)·2/(1 + a²)
-            2.0 * (1.0 - arg * arg) / ((arg * arg + 1.0) * (arg * arg + 1.0))
+            2.0 * (1.0 - arg * arg) * inv_a2 * inv_a2
         } else {
-            (p.pky4 * at).cos() * p.pky4 / (arg * arg + 1.0)
+            (p.pky4 * at).cos() * p.pky4 * inv_a2
         };
         let cos_shape = if pky4_is_2 {
-            (1.0 - arg * arg) / (arg * arg + 1.0)
+            (1.0 - arg * arg) * inv_a2
         } else {
             (p.pky4 * at).cos()
         };
@@ -274,10 +277,10 @@ impl PureGrad {
         gr[7] = -ge * e1 * gs * s_ay; // pey4
         gr[8] = ge * e1 * gs * gs; // pey5
         gr[9] = g_k * kya_rest * ppy1_f; // pky1
-        gr[10] = -g_arg * arg / den1; // pky2
+        gr[10] = -g_arg * arg * inv_den1; // pky2
         gr[11] = -g_k * p.pky1 * self.fz0p * ppy1_f * gs.abs() * shape * p.lky; // pky3
         gr[12] = g_shape * cos_shape * at; // pky4
-        gr[13] = -g_arg * arg * gs * gs / den1; // pky5
+        gr[13] = -g_arg * arg * gs * gs * inv_den1; // pky5
         let gk0 = g_kyg0 * fz * p.lkyc;
         gr[14] = gk0 * ppy5_f; // pky6
         gr[15] = gk0 * dfz * ppy5_f; // pky7
@@ -351,6 +354,8 @@ impl PureGrad {
         }
         let fx = w.g * fx0; // 4.E50
         let Some(gr) = grad else { return fx };
+        let gr = &mut gr[..FX_KEYS.len()];
+        let inv_den = 1.0 / den;
 
         let f = if neg { -w.g } else { w.g };
         let f_in = f * dx * co * cx / (inner * inner + 1.0);
@@ -358,9 +363,9 @@ impl PureGrad {
         let g_ex = if capped { 0.0 } else { -f_in * (x - ax) };
         let g_bx = g_x * kx;
         let g_kx = g_x * bx;
-        let g_kxk = g_bx / den;
-        let g_dx = f * s - g_bx * bx * cx / den;
-        let g_cx = f * dx * co * ai - g_bx * bx * dx / den;
+        let g_kxk = g_bx * inv_den;
+        let g_dx = f * s - g_bx * bx * cx * inv_den;
+        let g_cx = f * dx * co * ai - g_bx * bx * dx * inv_den;
         let gm = if fz == 0.0 { 0.0 } else { g_dx * fz * lmux };
         gr[0] = g_cx * p.lcx; // pcx1
         gr[1] = gm * m2 * m3; // pdx1

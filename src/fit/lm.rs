@@ -7,9 +7,13 @@
 //! iteration and QR-factorises the whole m×n matrix; it also exposes no Gram
 //! matrix for standard errors and the identifiability test. For m = 100 000
 //! residuals and n ≈ 25 parameters the normal equations are the better
-//! trade: JᵀWJ (n×n) is one cache-blocked symmetric product over a Jacobian
-//! buffer allocated once per fit (the problem writes J straight into it),
-//! and everything after it is n×n work. The normal equations square
+//! trade: JᵀWJ (n×n) is accumulated block by block — a problem offering
+//! [`Problem::row_jacobian`] fills 128-row blocks that are multiplied into
+//! the upper triangle while in L1, on its threads, in fixed 8192-row chunks
+//! summed in chunk order (so the result does not depend on the thread
+//! count), and the m×n J is never stored; other problems write J into a
+//! buffer allocated once per fit — and everything after it is n×n work.
+//! The normal equations square
 //! the condition number, which is acceptable here because collinear or
 //! inert parameters are removed first (see `identify`) and the damping
 //! keeps the system positive definite.
@@ -26,7 +30,17 @@
 //!    diag(A) (Marquardt scaling, MINPACK style);
 //! 4. project θ+δ into the box, accept if the actual cost reduction is a
 //!    positive fraction of the one the quadratic model predicts for the
-//!    projected step; update λ by the gain ratio (Nielsen).
+//!    projected step; update λ by the gain ratio (Nielsen). With λ ≤ 1e-2
+//!    the trial point is linearised at once (its cost comes with it; one
+//!    residual pass saved per accepted step);
+//! 5. stop when the nearly undamped (λ ≤ 1e-3) step's predicted gain is
+//!    below `ftol`·cost: that step is still taken if it lowers the cost
+//!    (one residual pass), and the last linearisation is handed to the
+//!    caller (identifiability, standard errors) instead of another J at a
+//!    point one negligible step away. The cost reported is always θ's own,
+//!    on all residuals. Also: actual and predicted reductions of an
+//!    accepted step both below `ftol`, scaled step below `xtol`, scaled
+//!    gradient below `gtol`.
 //!
 //! Must never: step outside the bounds, use randomness or wall-clock time
 //! (results are bit-reproducible), or panic on a non-finite residual (a
@@ -109,9 +123,10 @@ pub struct LmResult {
     pub initial_cost: f64,
     /// Cost at the solution.
     pub cost: f64,
-    /// Outer iterations (Jacobian evaluations).
+    /// Outer iterations (accepted linearisations, the start's included).
     pub iterations: usize,
-    /// Residual evaluations (trial steps).
+    /// Trial steps evaluated (by residuals, or by a linearisation at the
+    /// trial point when the step is nearly undamped).
     pub residual_evals: usize,
     pub termination: Termination,
     /// The last linearisation over the free columns, when it is at `theta`
@@ -705,9 +720,26 @@ pub fn minimize_from(
                 xn += diag[k] * theta[cols[k]] * theta[cols[k]];
             }
             let (dx, xn) = (dx.sqrt(), xn.sqrt());
-            problem.residuals(&trial, &mut ws.r_trial);
+            // Little damped (λ ≤ 1e-2), the step is usually accepted: then linearise
+            // at the trial point at once (its cost comes with it), saving
+            // the separate residual evaluation. A trial whose residuals or
+            // Jacobian are not finite counts as infinitely costly.
+            let fused = !last && lambda <= 1e-2;
+            let mut trial_lin = None;
+            let new_cost = if fused {
+                match linearise(problem, &trial, &cols, loss, ws) {
+                    Ok(l) => {
+                        let c = l.cost;
+                        trial_lin = Some(l);
+                        c
+                    }
+                    Err(_) => f64::INFINITY,
+                }
+            } else {
+                problem.residuals(&trial, &mut ws.r_trial);
+                cost_of(loss, &ws.r_trial, w)
+            };
             residual_evals += 1;
-            let new_cost = cost_of(loss, &ws.r_trial, w);
             let actual = cost - new_cost;
             if last {
                 if actual > 0.0 {
@@ -728,6 +760,10 @@ pub fn minimize_from(
                 if let Some(p) = progress.as_mut() {
                     p(iterations, cost);
                 }
+                if let Some(l) = trial_lin {
+                    lin = l;
+                    lin_at_theta = true;
+                }
                 if small_f {
                     break 'outer Termination::Cost;
                 }
@@ -737,8 +773,10 @@ pub fn minimize_from(
                 if iterations >= opts.max_iter {
                     break 'outer Termination::MaxIterations;
                 }
-                lin = linearise(problem, &theta, &cols, loss, ws)?;
-                lin_at_theta = true;
+                if !lin_at_theta {
+                    lin = linearise(problem, &theta, &cols, loss, ws)?;
+                    lin_at_theta = true;
+                }
                 cost = lin.cost;
                 continue 'outer;
             }

@@ -1,7 +1,10 @@
 //! mf_stages — the Magic Formula as fitting problems: one [`MfStage`] per
 //! channel and group of `.tir` parameters (pure Fy, pure Fx, Mz, combined
-//! slip, Mx, My), with exact Jacobians by forward-mode automatic
-//! differentiation: the stage's free parameters are seeded as `num-dual`
+//! slip, Mx, My), with exact Jacobians: closed forms in `f64` for pure Fx
+//! and pure Fy ([`super::grad_pure`], when every parameter of the stage is a
+//! pure-slip coefficient of its channel — the default tables are), else
+//! forward-mode automatic differentiation: the stage's free parameters are
+//! seeded as `num-dual`
 //! dual numbers, sixteen at a time (per lane the cheapest width of
 //! `DualSVec64` for these equations: 8 lanes ≈ 0.6 µs, 16 ≈ 0.9 µs, 32 ≈
 //! 6 µs per pure-Fy sample on the project machine), and only the fitted
@@ -626,16 +629,25 @@ struct AnalyticRows<'s> {
 
 impl RowJacobian for AnalyticRows<'_> {
     fn rows(&self, first: usize, r: &mut [f64], jac: &mut DMatrixViewMut<f64>) {
-        let mut g = [0.0; grad_pure::MAX_KEYS];
-        for (k, rk) in r.iter_mut().enumerate() {
-            let i = first + k;
-            let y = self
-                .grad
-                .eval(&self.conds[i], self.factors[i], Some(&mut g));
-            *rk = y - self.meas[i];
-            for (j, &l) in self.map.iter().enumerate() {
-                jac[(k, j)] = g[l];
+        // Gradients row by row into a small row-major buffer, then column by
+        // column into `jac` (no per-entry index arithmetic on the view).
+        const ROWS: usize = 64;
+        let mut buf = [[0.0; grad_pure::MAX_KEYS]; ROWS];
+        let mut k0 = 0;
+        while k0 < r.len() {
+            let nb = ROWS.min(r.len() - k0);
+            for (k, g) in buf[..nb].iter_mut().enumerate() {
+                let i = first + k0 + k;
+                let y = self.grad.eval(&self.conds[i], self.factors[i], Some(g));
+                r[k0 + k] = y - self.meas[i];
             }
+            for (j, &l) in self.map.iter().enumerate() {
+                let mut col = jac.column_mut(j);
+                for (v, g) in col.rows_mut(k0, nb).iter_mut().zip(&buf[..nb]) {
+                    *v = g[l];
+                }
+            }
+            k0 += nb;
         }
     }
 }

@@ -19,7 +19,9 @@
 //! - [`Problem::jacobian`]: r and the exact ∂r/∂θ for the requested columns
 //!   only (`cols`), written column k ↔ `cols[k]` into a column-major view.
 //!   For the Magic Formula: seed a dual number per requested column.
-//! - optionally [`Problem::weights`] (e.g. 1/σ² per channel).
+//! - optionally [`Problem::weights`] (e.g. 1/σ² per channel), and
+//!   [`Problem::row_jacobian`] + [`Problem::threads`]: J by row blocks, so the
+//!   fitter accumulates JᵀJ without storing J (the MF stages do).
 //!
 //! For a model predicting a channel sample by sample, implement
 //! [`SampleModel`] instead and let [`RecordingProblem`] build the problem

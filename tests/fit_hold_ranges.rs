@@ -19,7 +19,8 @@ use tyrekit::mf::{MfInput, Tyre, UseMode};
 use tyrekit::rig::{simulate, RigConfig, SteadyMf};
 use tyrekit::tir::TyreParams;
 
-fn recording(tag: &str) -> Recording {
+/// The rig recording written to `DIR/rig.mat` (DIR a fresh temporary folder).
+fn rig_file(tag: &str) -> (std::path::PathBuf, std::path::PathBuf) {
     let truth = Tyre::builtin();
     let mut cfg = RigConfig::standard(&truth, 5);
     cfg.sample_rate = 40.0;
@@ -28,6 +29,11 @@ fn recording(tag: &str) -> Recording {
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("rig.mat");
     run.write_mat(&path, false).unwrap();
+    (dir, path)
+}
+
+fn recording(tag: &str) -> Recording {
+    let (dir, path) = rig_file(tag);
     let rec = Recording::from_file(&path).unwrap();
     let _ = std::fs::remove_dir_all(&dir);
     rec
@@ -152,4 +158,34 @@ fn unknown_hold_key_is_an_error_naming_it() {
             .to_string();
         assert!(e.contains(key) && e.contains(why), "{e}");
     }
+}
+
+/// `tyrekit fit --hold`: the written tyre keeps the held keys' start values;
+/// an unknown key fails the command with a message naming it.
+#[test]
+fn cli_hold_option() {
+    let (dir, rec) = rig_file("cli");
+    let out = dir.join("fitted.tir");
+    let run = |hold: &str| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_tyrekit"))
+            .args(["fit", rec.to_str().unwrap(), "--out", out.to_str().unwrap()])
+            .args(["--only", "fy", "--hold", hold])
+            .output()
+            .unwrap();
+        (
+            o.status.success(),
+            String::from_utf8_lossy(&o.stderr).to_string(),
+        )
+    };
+    let (ok, err) = run("PDY1,PKY1");
+    assert!(ok, "{err}");
+    let fitted = TyreParams::from_file(&out).unwrap();
+    let start = TyreParams::builtin();
+    for k in ["PDY1", "PKY1"] {
+        assert_eq!(fitted.get(k), start.get(k), "{k}");
+    }
+    assert_ne!(fitted.get("PCY1"), start.get("PCY1"));
+    let (ok, err) = run("PDY1,PXY7");
+    assert!(!ok && err.contains("PXY7"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -44,6 +44,10 @@ pub struct Args {
     /// Directory for fit.json and the SVG plots.
     #[arg(long)]
     pub report: Option<PathBuf>,
+    /// Coefficients to hold at their start values, comma-separated .tir keys
+    /// (e.g. PKY4,PEY3); a key no stage fits is an error.
+    #[arg(long, value_delimiter = ',')]
+    pub hold: Vec<String>,
 }
 
 fn parse_model(s: &str) -> Result<MfVersion> {
@@ -79,6 +83,7 @@ pub fn run(args: Args) -> Result<()> {
         }
         opts.only = only;
     }
+    opts.fit.hold = args.hold.clone();
     let mut start = match &args.start {
         Some(p) => {
             opts.nominal_from_data = false;

@@ -7,9 +7,13 @@
 //! iteration and QR-factorises the whole m×n matrix; it also exposes no Gram
 //! matrix for standard errors and the identifiability test. For m = 100 000
 //! residuals and n ≈ 25 parameters the normal equations are the better
-//! trade: JᵀWJ (n×n) is one cache-blocked symmetric product over a Jacobian
-//! buffer allocated once per fit (the problem writes J straight into it),
-//! and everything after it is n×n work. The normal equations square
+//! trade: JᵀWJ (n×n) is accumulated block by block — a problem offering
+//! [`Problem::row_jacobian`] fills 128-row blocks that are multiplied into
+//! the upper triangle while in L1, on its threads, in fixed 8192-row chunks
+//! summed in chunk order (so the result does not depend on the thread
+//! count), and the m×n J is never stored; other problems write J into a
+//! buffer allocated once per fit — and everything after it is n×n work.
+//! The normal equations square
 //! the condition number, which is acceptable here because collinear or
 //! inert parameters are removed first (see `identify`) and the damping
 //! keeps the system positive definite.
@@ -26,7 +30,17 @@
 //!    diag(A) (Marquardt scaling, MINPACK style);
 //! 4. project θ+δ into the box, accept if the actual cost reduction is a
 //!    positive fraction of the one the quadratic model predicts for the
-//!    projected step; update λ by the gain ratio (Nielsen).
+//!    projected step; update λ by the gain ratio (Nielsen). With λ ≤ 1e-2
+//!    the trial point is linearised at once (its cost comes with it; one
+//!    residual pass saved per accepted step);
+//! 5. stop when the nearly undamped (λ ≤ 1e-3) step's predicted gain is
+//!    below `ftol`·cost: that step is still taken if it lowers the cost
+//!    (one residual pass), and the last linearisation is handed to the
+//!    caller (identifiability, standard errors) instead of another J at a
+//!    point one negligible step away. The cost reported is always θ's own,
+//!    on all residuals. Also: actual and predicted reductions of an
+//!    accepted step both below `ftol`, scaled step below `xtol`, scaled
+//!    gradient below `gtol`.
 //!
 //! Must never: step outside the bounds, use randomness or wall-clock time
 //! (results are bit-reproducible), or panic on a non-finite residual (a
@@ -109,11 +123,18 @@ pub struct LmResult {
     pub initial_cost: f64,
     /// Cost at the solution.
     pub cost: f64,
-    /// Outer iterations (Jacobian evaluations).
+    /// Outer iterations (accepted linearisations, the start's included).
     pub iterations: usize,
-    /// Residual evaluations (trial steps).
+    /// Trial steps evaluated (by residuals, or by a linearisation at the
+    /// trial point when the step is nearly undamped).
     pub residual_evals: usize,
     pub termination: Termination,
+    /// The last linearisation over the free columns, when it is at `theta`
+    /// or one final step of predicted gain ≤ ftol·cost away from it (the
+    /// run's last step, taken without linearising again): good for
+    /// identifiability and standard errors at the solution, and saves the
+    /// caller an evaluation of J. Its `cost` is that of its own point.
+    pub linearisation: Option<Linearisation>,
 }
 
 /// The problem linearised at θ over the columns `cols`: the weighted Gram
@@ -177,7 +198,7 @@ impl Workspace {
 
 /// Dot product with four independent accumulators (lets the compiler
 /// vectorise; the summation order is fixed, so results are reproducible).
-#[inline]
+#[inline(always)]
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     let mut acc = [0.0f64; 4];
     let ca = a.chunks_exact(4);
@@ -195,27 +216,34 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     s
 }
 
-/// Four dot products of `a` with `b[0..4]`, each with two accumulators
-/// (fixed summation order: reproducible).
-#[inline]
+/// Four dot products of `a` with `b[0..4]`, each over four interleaved
+/// accumulators (row i → accumulator i mod 4) combined as (0 + 1) + (2 + 3):
+/// a fixed summation order, so the result is reproducible and the same for
+/// whichever instruction set [`gram_add`] compiled it for.
+#[inline(always)]
 fn dot4(a: &[f64], b: [&[f64]; 4]) -> [f64; 4] {
     let n = a.len();
-    let mut acc = [[0.0f64; 2]; 4];
-    let half = n / 2 * 2;
-    let mut i = 0;
-    while i < half {
-        let (x0, x1) = (a[i], a[i + 1]);
-        for l in 0..4 {
-            acc[l][0] += x0 * b[l][i];
-            acc[l][1] += x1 * b[l][i + 1];
+    let (b0, b1, b2, b3) = (&b[0][..n], &b[1][..n], &b[2][..n], &b[3][..n]);
+    let mut acc = [[0.0f64; 4]; 4];
+    let n4 = n / 4 * 4;
+    for (((x, y0), (y1, y2)), y3) in a[..n4]
+        .chunks_exact(4)
+        .zip(b0[..n4].chunks_exact(4))
+        .zip(b1[..n4].chunks_exact(4).zip(b2[..n4].chunks_exact(4)))
+        .zip(b3[..n4].chunks_exact(4))
+    {
+        for j in 0..4 {
+            acc[0][j] += x[j] * y0[j];
+            acc[1][j] += x[j] * y1[j];
+            acc[2][j] += x[j] * y2[j];
+            acc[3][j] += x[j] * y3[j];
         }
-        i += 2;
     }
     let mut out = [0.0; 4];
     for l in 0..4 {
-        out[l] = acc[l][0] + acc[l][1];
-        if half < n {
-            out[l] += a[half] * b[l][half];
+        out[l] = (acc[l][0] + acc[l][1]) + (acc[l][2] + acc[l][3]);
+        for i in n4..n {
+            out[l] += a[i] * b[l][i];
         }
     }
     out
@@ -241,9 +269,34 @@ fn gram_slice(
     a: &mut DMatrix<f64>,
     g: &mut DVector<f64>,
 ) {
-    const BLOCK: usize = 2048;
     a.fill(0.0);
     g.fill(0.0);
+    gram_add(data, m, k, r, a, g);
+    mirror_upper(a);
+}
+
+/// Copy the upper triangle of `a` into the lower.
+fn mirror_upper(a: &mut DMatrix<f64>) {
+    for p in 0..a.ncols() {
+        for q in 0..p {
+            a[(p, q)] = a[(q, p)];
+        }
+    }
+}
+
+/// Add JᵀJ (upper triangle only) and Jᵀr of a column-major m×k `data` to
+/// `a` and `g`, over row blocks small enough that the k column pieces stay
+/// in cache while all k(k+1)/2 products are taken.
+#[inline(always)]
+fn gram_add_impl(
+    data: &[f64],
+    m: usize,
+    k: usize,
+    r: &[f64],
+    a: &mut DMatrix<f64>,
+    g: &mut DVector<f64>,
+) {
+    const BLOCK: usize = 2048;
     let mut start = 0;
     while start < m {
         let end = (start + BLOCK).min(m);
@@ -267,11 +320,142 @@ fn gram_slice(
         }
         start = end;
     }
-    for p in 0..k {
-        for q in 0..p {
-            a[(p, q)] = a[(q, p)];
-        }
+}
+
+/// [`gram_add_impl`], compiled for AVX2 when the CPU has it (4-wide
+/// vectors instead of SSE2's 2; no FMA, and the kernels fix the summation
+/// order, so the result has the same bits either way).
+fn gram_add(
+    data: &[f64],
+    m: usize,
+    k: usize,
+    r: &[f64],
+    a: &mut DMatrix<f64>,
+    g: &mut DVector<f64>,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU supports AVX2 (checked just above).
+        unsafe { gram_add_avx2(data, m, k, r, a, g) };
+        return;
     }
+    gram_add_impl(data, m, k, r, a, g)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn gram_add_avx2(
+    data: &[f64],
+    m: usize,
+    k: usize,
+    r: &[f64],
+    a: &mut DMatrix<f64>,
+    g: &mut DVector<f64>,
+) {
+    gram_add_impl(data, m, k, r, a, g)
+}
+
+/// Rows per chunk of the blocked linearisation ([`linearise_rows`]): fixed,
+/// not per thread, so the chunks' partial sums, added in chunk order, are
+/// the same whatever the thread count (bit-reproducible results).
+const CHUNK_ROWS: usize = 8192;
+/// Rows per Jacobian block within a chunk: a 128 × 30 block (30 kB) stays in
+/// L1 between being written and being multiplied.
+const BLOCK_ROWS: usize = 128;
+
+/// One chunk's share of the linearisation.
+struct Partial {
+    a: DMatrix<f64>,
+    g: DVector<f64>,
+    cost: f64,
+    wrss: f64,
+}
+
+/// The linearisation by row blocks of a [`RowJacobian`]: each block's r and
+/// J are computed into a small buffer, weighted by √ω (IRLS), and their
+/// upper-triangle JᵀJ and Jᵀr added to the chunk's partial; chunks are
+/// spread over `threads` scoped threads and their partials summed in chunk
+/// order. The m × k Jacobian is never stored.
+#[allow(clippy::too_many_arguments)]
+fn linearise_rows(
+    rows: &dyn super::problem::RowJacobian,
+    m: usize,
+    k: usize,
+    w: Option<&[f64]>,
+    loss: &Loss,
+    threads: usize,
+) -> (DMatrix<f64>, DVector<f64>, f64, f64) {
+    let unit = w.is_none() && loss.kind == super::loss::LossKind::Linear;
+    let n_chunks = m.div_ceil(CHUNK_ROWS).max(1);
+    let mut parts: Vec<Partial> = (0..n_chunks)
+        .map(|_| Partial {
+            a: DMatrix::zeros(k, k),
+            g: DVector::zeros(k),
+            cost: 0.0,
+            wrss: 0.0,
+        })
+        .collect();
+    let work = |c0: usize, parts: &mut [Partial]| {
+        let mut r = vec![0.0; BLOCK_ROWS];
+        let mut jac = vec![0.0; BLOCK_ROWS * k];
+        for (ci, part) in parts.iter_mut().enumerate() {
+            let chunk_start = (c0 + ci) * CHUNK_ROWS;
+            let chunk_end = (chunk_start + CHUNK_ROWS).min(m);
+            let mut b0 = chunk_start;
+            while b0 < chunk_end {
+                let nb = BLOCK_ROWS.min(chunk_end - b0);
+                let (rb, jb) = (&mut r[..nb], &mut jac[..nb * k]);
+                rows.rows(b0, rb, &mut DMatrixViewMut::from_slice(jb, nb, k));
+                for i in 0..nb {
+                    let (c, om) = loss.cost_and_weight(rb[i], w.map_or(1.0, |w| w[b0 + i]));
+                    part.cost += c;
+                    part.wrss += om * rb[i] * rb[i];
+                    if !unit {
+                        let s = om.sqrt();
+                        rb[i] *= s;
+                        for j in 0..k {
+                            jb[j * nb + i] *= s;
+                        }
+                    }
+                }
+                gram_add(jb, nb, k, rb, &mut part.a, &mut part.g);
+                b0 += nb;
+            }
+        }
+    };
+    let threads = threads.clamp(1, n_chunks);
+    if threads == 1 {
+        work(0, &mut parts);
+    } else {
+        std::thread::scope(|s| {
+            let mut rest: &mut [Partial] = &mut parts;
+            let mut c0 = 0;
+            for t in 0..threads {
+                let take = (n_chunks * (t + 1)) / threads - (n_chunks * t) / threads;
+                let (mine, tail) = rest.split_at_mut(take);
+                rest = tail;
+                let work = &work;
+                let start = c0;
+                if t + 1 == threads {
+                    work(start, mine);
+                } else {
+                    s.spawn(move || work(start, mine));
+                }
+                c0 += take;
+            }
+        });
+    }
+    let mut a = DMatrix::zeros(k, k);
+    let mut g = DVector::zeros(k);
+    let (mut cost, mut wrss) = (0.0, 0.0);
+    for p in &parts {
+        a += &p.a;
+        g += &p.g;
+        cost += p.cost;
+        wrss += p.wrss;
+    }
+    mirror_upper(&mut a);
+    (a, g, cost, wrss)
 }
 
 /// Robust cost of a residual vector (∞ if any residual is not finite).
@@ -284,18 +468,19 @@ fn cost_of(loss: &Loss, r: &[f64], w: Option<&[f64]>) -> f64 {
     }
 }
 
-/// Linearise `problem` at `theta` over `cols` (see [`Linearisation`]).
-pub fn linearise(
+/// The linearisation through [`Problem::jacobian`]: the whole m × k
+/// Jacobian into the workspace, then one blocked product.
+fn linearise_full(
     problem: &dyn Problem,
     theta: &[f64],
     cols: &[usize],
     loss: &Loss,
     ws: &mut Workspace,
-) -> crate::Result<Linearisation> {
+) -> (DMatrix<f64>, DVector<f64>, f64, f64) {
     let m = problem.n_residuals();
     let k = cols.len();
     if ws.r.len() != m {
-        *ws = Workspace::new(m, k);
+        *ws = Workspace::new(m, 0);
     }
     ws.ensure_cols(k);
     problem.jacobian(
@@ -312,11 +497,6 @@ pub fn linearise(
         cost += c;
         wrss += om * ws.r[i] * ws.r[i];
         ws.sw[i] = om.sqrt();
-    }
-    if !cost.is_finite() {
-        return Err(crate::Error::Numeric(
-            "fit: the residuals are not finite at the current parameters".into(),
-        ));
     }
     // Row scaling by √ω (skipped when every ω is 1: plain, unweighted LS).
     let unit = w.is_none() && loss.kind == super::loss::LossKind::Linear;
@@ -336,6 +516,29 @@ pub fn linearise(
     let mut a = DMatrix::zeros(k, k);
     let mut g = DVector::zeros(k);
     gram_slice(&ws.jac, m, k, &ws.r_trial, &mut a, &mut g);
+    (a, g, cost, wrss)
+}
+
+/// Linearise `problem` at `theta` over `cols` (see [`Linearisation`]).
+pub fn linearise(
+    problem: &dyn Problem,
+    theta: &[f64],
+    cols: &[usize],
+    loss: &Loss,
+    ws: &mut Workspace,
+) -> crate::Result<Linearisation> {
+    let m = problem.n_residuals();
+    let k = cols.len();
+    let w = problem.weights();
+    let (a, g, cost, wrss) = match problem.row_jacobian(theta, cols) {
+        Some(rows) => linearise_rows(rows.as_ref(), m, k, w, loss, problem.threads()),
+        None => linearise_full(problem, theta, cols, loss, ws),
+    };
+    if !cost.is_finite() {
+        return Err(crate::Error::Numeric(
+            "fit: the residuals are not finite at the current parameters".into(),
+        ));
+    }
     // A non-finite Jacobian entry makes its column's diagonal non-finite.
     if (0..k).any(|j| !a[(j, j)].is_finite() || !g[j].is_finite()) {
         return Err(crate::Error::Numeric(
@@ -402,7 +605,7 @@ pub fn minimize_from(
     let w = problem.weights();
     let loss = &opts.loss;
     if ws.r.len() != m {
-        *ws = Workspace::new(m, n);
+        *ws = Workspace::new(m, 0);
     }
     if n == 0 || m == 0 {
         problem.residuals(&theta, &mut ws.r);
@@ -414,6 +617,7 @@ pub fn minimize_from(
             iterations: 0,
             residual_evals: 1,
             termination: Termination::NoFreeParameters,
+            linearisation: None,
         });
     }
     let lower: Vec<f64> = cols.iter().map(|&c| params[c].lower).collect();
@@ -434,6 +638,10 @@ pub fn minimize_from(
     let mut mat = DMatrix::<f64>::zeros(n, n);
     let mut rhs = DVector::<f64>::zeros(n);
     let mut active = vec![false; n];
+    // Whether `lin` is at `theta` (false only after a final accepted step),
+    // or one last step of gain below ftol away from it.
+    let mut lin_at_theta = true;
+    let mut lin_near_theta = false;
 
     let termination = 'outer: loop {
         iterations += 1;
@@ -498,6 +706,13 @@ pub fn minimize_from(
             }
             // Predicted reduction of the quadratic model for s.
             let pred = -(lin.g.dot(&s) + 0.5 * s.dot(&(&lin.a * &s)));
+            // Nearly undamped (λ ≤ 1e-3: the step is the Gauss–Newton step
+            // to 0.1 %) and the model predicts a gain below ftol: θ is the
+            // minimum to that tolerance. Take this last step if it lowers the
+            // cost (one residual evaluation) and stop without linearising
+            // again: the last linearisation is one step of negligible
+            // predicted gain away, good for the caller's standard errors.
+            let last = lambda <= 1e-3 && (0.0..=opts.ftol * cost).contains(&pred);
             let mut dx = 0.0;
             let mut xn = 0.0;
             for k in 0..n {
@@ -505,19 +720,49 @@ pub fn minimize_from(
                 xn += diag[k] * theta[cols[k]] * theta[cols[k]];
             }
             let (dx, xn) = (dx.sqrt(), xn.sqrt());
-            problem.residuals(&trial, &mut ws.r_trial);
+            // Little damped (λ ≤ 1e-2), the step is usually accepted: then linearise
+            // at the trial point at once (its cost comes with it), saving
+            // the separate residual evaluation. A trial whose residuals or
+            // Jacobian are not finite counts as infinitely costly.
+            let fused = !last && lambda <= 1e-2;
+            let mut trial_lin = None;
+            let new_cost = if fused {
+                match linearise(problem, &trial, &cols, loss, ws) {
+                    Ok(l) => {
+                        let c = l.cost;
+                        trial_lin = Some(l);
+                        c
+                    }
+                    Err(_) => f64::INFINITY,
+                }
+            } else {
+                problem.residuals(&trial, &mut ws.r_trial);
+                cost_of(loss, &ws.r_trial, w)
+            };
             residual_evals += 1;
-            let new_cost = cost_of(loss, &ws.r_trial, w);
             let actual = cost - new_cost;
+            if last {
+                if actual > 0.0 {
+                    theta.copy_from_slice(&trial);
+                    cost = new_cost;
+                }
+                lin_near_theta = true;
+                break 'outer Termination::Cost;
+            }
             let rho = if pred > 0.0 { actual / pred } else { -1.0 };
             if rho > 1e-4 {
                 theta.copy_from_slice(&trial);
+                lin_at_theta = false;
                 let small_f = actual <= opts.ftol * cost && pred <= opts.ftol * cost;
                 cost = new_cost;
                 lambda *= (1.0f64 / 3.0).max(1.0 - (2.0 * rho - 1.0).powi(3));
                 nu = 2.0;
                 if let Some(p) = progress.as_mut() {
                     p(iterations, cost);
+                }
+                if let Some(l) = trial_lin {
+                    lin = l;
+                    lin_at_theta = true;
                 }
                 if small_f {
                     break 'outer Termination::Cost;
@@ -528,7 +773,10 @@ pub fn minimize_from(
                 if iterations >= opts.max_iter {
                     break 'outer Termination::MaxIterations;
                 }
-                lin = linearise(problem, &theta, &cols, loss, ws)?;
+                if !lin_at_theta {
+                    lin = linearise(problem, &theta, &cols, loss, ws)?;
+                    lin_at_theta = true;
+                }
                 cost = lin.cost;
                 continue 'outer;
             }
@@ -555,6 +803,7 @@ pub fn minimize_from(
         iterations,
         residual_evals,
         termination,
+        linearisation: (lin_at_theta || lin_near_theta).then_some(lin),
     })
 }
 

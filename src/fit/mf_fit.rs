@@ -41,14 +41,7 @@ pub struct MfFitOptions {
 impl Default for MfFitOptions {
     fn default() -> Self {
         MfFitOptions {
-            only: vec![
-                StageKind::PureFx,
-                StageKind::PureFy,
-                StageKind::Mz,
-                StageKind::Combined,
-                StageKind::Mx,
-                StageKind::My,
-            ],
+            only: StageKind::ALL.to_vec(),
             transient: false,
             holdout: Holdout::None,
             nominal_from_data: true,
@@ -111,43 +104,68 @@ pub fn nominal_from_data(tyre: &mut TyreParams, recs: &[Recording]) -> crate::Re
 }
 
 /// Widen the range limits of the file (FZMIN/FZMAX, ALPMIN/ALPMAX,
-/// KPUMIN/KPUMAX, CAMMIN/CAMMAX) so they contain the data: a fitted tyre must
-/// not clip the conditions it was fitted on.
-fn widen_ranges(tyre: &mut TyreParams, recs: &[Recording]) -> crate::Result<()> {
-    let span = |f: fn(&crate::data::Sample) -> f64| {
+/// KPUMIN/KPUMAX, CAMMIN/CAMMAX, PRESMIN/PRESMAX) so they contain the data
+/// with a margin of 20 % of the limit's magnitude: a fitted tyre must not
+/// clip the conditions it was fitted on (the FMU's use modes 1xx clip
+/// inputs to these ranges). FZMIN is never lowered: below it the moment
+/// equations reduce the load (Fz·(Fz/FZMIN)², `Model::mx`), so it is a
+/// model parameter rather than a validity limit. A limit the data lie
+/// inside stays as it was.
+pub fn widen_ranges(tyre: &mut TyreParams, recs: &[Recording]) -> crate::Result<()> {
+    type Get = fn(&crate::data::Sample) -> f64;
+    const PAD: f64 = 0.2;
+    for (lo_k, hi_k, f) in [
+        ("FZMIN", "FZMAX", (|s| s.fz) as Get),
+        ("ALPMIN", "ALPMAX", |s| s.alpha),
+        ("KPUMIN", "KPUMAX", |s| s.kappa),
+        ("CAMMIN", "CAMMAX", |s| s.gamma),
+        // A pressure of 0 means "not measured" (as NaN does).
+        (
+            "PRESMIN",
+            "PRESMAX",
+            |s| if s.p > 0.0 { s.p } else { f64::NAN },
+        ),
+    ] {
         let mut lo = f64::INFINITY;
         let mut hi = f64::NEG_INFINITY;
-        for s in recs.iter().flat_map(|r| &r.samples) {
-            let v = f(s);
+        for v in recs.iter().flat_map(|r| &r.samples).map(f) {
             if v.is_finite() {
                 lo = lo.min(v);
                 hi = hi.max(v);
             }
         }
-        (lo, hi)
-    };
-    for (lo_k, hi_k, f, pad) in [
-        (
-            "FZMIN",
-            "FZMAX",
-            (|s: &crate::data::Sample| s.fz) as fn(&crate::data::Sample) -> f64,
-            1.2,
-        ),
-        ("ALPMIN", "ALPMAX", |s| s.alpha, 1.2),
-        ("KPUMIN", "KPUMAX", |s| s.kappa, 1.2),
-        ("CAMMIN", "CAMMAX", |s| s.gamma, 1.2),
-    ] {
-        let (lo, hi) = span(f);
         if !(lo.is_finite() && hi.is_finite()) {
             continue;
         }
         if let (Some(a), Some(b)) = (tyre.get(lo_k), tyre.get(hi_k)) {
             if lo_k != "FZMIN" && lo < a {
-                tyre.set(lo_k, lo * pad)?;
+                tyre.set(lo_k, lo - PAD * lo.abs())?;
             }
             if hi > b {
-                tyre.set(hi_k, hi * pad)?;
+                tyre.set(hi_k, hi + PAD * hi.abs())?;
             }
+        }
+    }
+    Ok(())
+}
+
+/// Check the hold list of `opts` against the coefficients the stages fit:
+/// an unknown name is an error naming it (a typo must not silently fit
+/// the coefficient it meant to hold).
+fn check_hold(hold: &[String]) -> crate::Result<()> {
+    for h in hold {
+        let known = StageKind::ALL
+            .iter()
+            .any(|k| k.table().iter().any(|e| e.0.eq_ignore_ascii_case(h.trim())));
+        if !known {
+            let why = if crate::tir::keys::key_index(h.trim()).is_some() {
+                "a .tir key that no fit stage fits"
+            } else {
+                "not a .tir key"
+            };
+            return Err(crate::Error::Input(format!(
+                "fit --hold '{h}': {why} (expected coefficients of the Fx, Fy, Mz, combined, Mx or My stages, e.g. PDY1)"
+            )));
         }
     }
     Ok(())
@@ -179,6 +197,7 @@ pub fn fit_mf(
     opts: &MfFitOptions,
     mut progress: Option<&mut ProgressFn>,
 ) -> crate::Result<MfFit> {
+    check_hold(&opts.fit.hold)?;
     let mut tyre = start;
     if opts.nominal_from_data {
         nominal_from_data(&mut tyre, recs)?;
@@ -199,14 +218,7 @@ pub fn fit_mf(
     };
     let mut skipped = Vec::new();
     let mut fitted_channels: Vec<(Channel, crate::data::SegmentKind)> = Vec::new();
-    for kind in [
-        StageKind::PureFx,
-        StageKind::PureFy,
-        StageKind::Mz,
-        StageKind::Combined,
-        StageKind::Mx,
-        StageKind::My,
-    ] {
+    for kind in StageKind::ALL {
         if !opts.only.contains(&kind) {
             continue;
         }

@@ -1,7 +1,10 @@
 //! mf_stages — the Magic Formula as fitting problems: one [`MfStage`] per
 //! channel and group of `.tir` parameters (pure Fy, pure Fx, Mz, combined
-//! slip, Mx, My), with exact Jacobians by forward-mode automatic
-//! differentiation: the stage's free parameters are seeded as `num-dual`
+//! slip, Mx, My), with exact Jacobians: closed forms in `f64` for pure Fx
+//! and pure Fy ([`super::grad_pure`], when every parameter of the stage is a
+//! pure-slip coefficient of its channel — the default tables are), else
+//! forward-mode automatic differentiation: the stage's free parameters are
+//! seeded as `num-dual`
 //! dual numbers, sixteen at a time (per lane the cheapest width of
 //! `DualSVec64` for these equations: 8 lanes ≈ 0.6 µs, 16 ≈ 0.9 µs, 32 ≈
 //! 6 µs per pure-Fy sample on the project machine), and only the fitted
@@ -23,7 +26,8 @@
 //! per sample.
 
 use super::channels;
-use super::problem::{par_rows, Param, Problem, Stack};
+use super::grad_pure;
+use super::problem::{par_rows, Param, Problem, RowJacobian, Stack};
 use super::solve::{fit_global, FitOptions, FitOutcome, ProgressFn};
 use crate::data::{Recording, Sample, SegmentKind};
 use crate::mf::{Conditions, Form, MfInput, Model, Solution, UseMode};
@@ -101,6 +105,16 @@ pub enum StageKind {
 }
 
 impl StageKind {
+    /// Every stage, in the order a staged fit runs them.
+    pub const ALL: [StageKind; 6] = [
+        StageKind::PureFx,
+        StageKind::PureFy,
+        StageKind::Mz,
+        StageKind::Combined,
+        StageKind::Mx,
+        StageKind::My,
+    ];
+
     /// Parse a `--only` word (`fx`, `fy`, `mz`, `combined`).
     pub fn parse(s: &str) -> Option<StageKind> {
         match s.trim().to_ascii_lowercase().as_str() {
@@ -435,7 +449,10 @@ pub fn gather(
 }
 
 /// One channel of a Magic Formula stage as a least-squares [`Problem`]:
-/// residual = model(θ, sample) − measured.
+/// residual = model(θ, sample) − measured. Pure Fx and pure Fy stages whose
+/// every parameter is a pure-slip coefficient of the channel use the closed
+/// forms of [`super::grad_pure`] (value and gradient in `f64`); every other
+/// stage, or one built [`MfStage::with_analytic`]`(false)`, uses num-dual.
 pub struct MfStage<'a> {
     form: Form,
     base: MfParams<f64>,
@@ -446,8 +463,19 @@ pub struct MfStage<'a> {
     meas: &'a [f64],
     channel: Channel,
     weights: Option<Vec<f64>>,
+    /// The closed-form path, when it applies and is on.
+    analytic: Option<Analytic>,
     /// Threads for evaluation (results do not depend on it).
     pub threads: usize,
+}
+
+/// What the closed-form path needs besides θ: the local gradient index
+/// ([`grad_pure::local_index`]) of every θ entry and the combined-slip
+/// factors of every sample (constant: the table holds no combined-slip
+/// coefficient).
+struct Analytic {
+    local: Vec<usize>,
+    factors: Vec<grad_pure::Weights>,
 }
 
 /// The parameter table of a stage, starting from `base`: camber terms held
@@ -494,7 +522,7 @@ impl<'a> MfStage<'a> {
         let meas = data.meas.get(k).ok_or_else(|| {
             crate::Error::Input(format!("fit: the stage data have no channel {k}"))
         })?;
-        Ok(MfStage {
+        let stage = MfStage {
             form,
             base: base.clone(),
             params,
@@ -503,8 +531,39 @@ impl<'a> MfStage<'a> {
             meas,
             channel,
             weights: None,
+            analytic: None,
             threads: 1,
-        })
+        };
+        Ok(stage.with_analytic(true))
+    }
+
+    /// Use the closed-form gradients of [`super::grad_pure`] where they apply
+    /// (`true`, the default), or num-dual for every stage (`false`, the
+    /// reference the closed forms are tested against).
+    pub fn with_analytic(mut self, on: bool) -> Self {
+        let local: Option<Vec<usize>> = self
+            .params
+            .iter()
+            .map(|p| grad_pure::local_index(self.channel, &p.name))
+            .collect();
+        self.analytic = match local {
+            Some(local) if on => {
+                let model = Model::new(self.base.clone(), self.form);
+                let factors = self
+                    .conds
+                    .iter()
+                    .map(|c| grad_pure::weights(&model, c, self.channel))
+                    .collect();
+                Some(Analytic { local, factors })
+            }
+            _ => None,
+        };
+        self
+    }
+
+    /// Whether the closed-form gradient path is in use.
+    pub fn is_analytic(&self) -> bool {
+        self.analytic.is_some()
     }
 
     /// Weight every residual by `w` (1/σ² of the channel when stacking).
@@ -537,21 +596,14 @@ impl<'a> MfStage<'a> {
             .map(|c| self.channel.of(&model.solve(c)))
             .collect()
     }
-}
 
-impl MfStage<'_> {
-    /// One Jacobian pass: the columns `chunk` (at most `N`) seeded as the
-    /// lanes of an `N`-lane dual number, written to columns `col0..` of `jac`
-    /// (and r on the first pass).
-    fn jacobian_pass<const N: usize>(
+    /// The dual-number model of one Jacobian pass: the columns `chunk` (at
+    /// most `N`) seeded as the lanes of an `N`-lane dual number.
+    fn dual_model<const N: usize>(
         &self,
         p: &MfParams<f64>,
         chunk: &[usize],
-        col0: usize,
-        r: &mut [f64],
-        jac: &mut DMatrixViewMut<f64>,
-    ) {
-        // Seed lane l with the key of chunk[l].
+    ) -> Model<DualSVec64<N>> {
         let mut lane_of = [usize::MAX; N];
         for (l, &c) in chunk.iter().enumerate() {
             lane_of[l] = self.keys[c];
@@ -561,28 +613,90 @@ impl MfStage<'_> {
                 Some(l) => DualSVec64::new(v, Derivative::derivative_generic(Const::<N>, U1, l)),
                 None => DualSVec64::from(v),
             });
-        let model = Model::new(pd, self.form);
-        let width = chunk.len();
-        par_rows(
-            self.threads,
-            0,
-            r,
-            Some(jac),
-            &|first, r: &mut [f64], jac| {
-                let Some(jac) = jac else { return };
-                for (k, rk) in r.iter_mut().enumerate() {
-                    let i = first + k;
-                    let y = channels::eval(&model, &self.conds[i], self.channel);
-                    if col0 == 0 {
-                        *rk = y.re - self.meas[i];
-                    }
-                    let g = y.eps.unwrap_generic(Const::<N>, U1);
-                    for l in 0..width {
-                        jac[(k, col0 + l)] = g[l];
-                    }
+        Model::new(pd, self.form)
+    }
+}
+
+/// The closed-form row Jacobian of an [`MfStage`] at one θ.
+struct AnalyticRows<'s> {
+    grad: grad_pure::PureGrad,
+    /// Local gradient index of every requested column.
+    map: Vec<usize>,
+    conds: &'s [Conditions],
+    meas: &'s [f64],
+    factors: &'s [grad_pure::Weights],
+}
+
+impl RowJacobian for AnalyticRows<'_> {
+    fn rows(&self, first: usize, r: &mut [f64], jac: &mut DMatrixViewMut<f64>) {
+        // Gradients row by row into a small row-major buffer, then column by
+        // column into `jac` (no per-entry index arithmetic on the view).
+        const ROWS: usize = 64;
+        let mut buf = [[0.0; grad_pure::MAX_KEYS]; ROWS];
+        let mut k0 = 0;
+        while k0 < r.len() {
+            let nb = ROWS.min(r.len() - k0);
+            for (k, g) in buf[..nb].iter_mut().enumerate() {
+                let i = first + k0 + k;
+                let y = self.grad.eval(&self.conds[i], self.factors[i], Some(g));
+                r[k0 + k] = y - self.meas[i];
+            }
+            for (j, &l) in self.map.iter().enumerate() {
+                let mut col = jac.column_mut(j);
+                for (v, g) in col.rows_mut(k0, nb).iter_mut().zip(&buf[..nb]) {
+                    *v = g[l];
                 }
-            },
-        );
+            }
+            k0 += nb;
+        }
+    }
+}
+
+/// The num-dual row Jacobian of an [`MfStage`] at one θ: passes of 16 lanes
+/// (the last one of 8 when that suffices; per lane the 16-lane dual is the
+/// cheapest num-dual width for these equations, see the module docs), each
+/// with its model prepared once.
+struct DualRows<'s> {
+    wide: Vec<(usize, usize, Model<DualSVec64<16>>)>,
+    narrow: Option<(usize, usize, Model<DualSVec64<8>>)>,
+    conds: &'s [Conditions],
+    meas: &'s [f64],
+    channel: Channel,
+}
+
+impl DualRows<'_> {
+    /// Columns `col0..col0 + width` from `model` (and r when `col0` is 0).
+    fn pass<const N: usize>(
+        &self,
+        model: &Model<DualSVec64<N>>,
+        col0: usize,
+        width: usize,
+        first: usize,
+        r: &mut [f64],
+        jac: &mut DMatrixViewMut<f64>,
+    ) {
+        for (k, rk) in r.iter_mut().enumerate() {
+            let i = first + k;
+            let y = channels::eval(model, &self.conds[i], self.channel);
+            if col0 == 0 {
+                *rk = y.re - self.meas[i];
+            }
+            let g = y.eps.unwrap_generic(Const::<N>, U1);
+            for l in 0..width {
+                jac[(k, col0 + l)] = g[l];
+            }
+        }
+    }
+}
+
+impl RowJacobian for DualRows<'_> {
+    fn rows(&self, first: usize, r: &mut [f64], jac: &mut DMatrixViewMut<f64>) {
+        for (col0, width, m) in &self.wide {
+            self.pass(m, *col0, *width, first, r, jac);
+        }
+        if let Some((col0, width, m)) = &self.narrow {
+            self.pass(m, *col0, *width, first, r, jac);
+        }
     }
 }
 
@@ -594,7 +708,19 @@ impl Problem for MfStage<'_> {
         self.meas.len()
     }
     fn residuals(&self, theta: &[f64], r: &mut [f64]) {
-        let model = Model::new(self.params_at(theta), self.form);
+        let p = self.params_at(theta);
+        if let Some(an) = &self.analytic {
+            if let Some(grad) = grad_pure::PureGrad::new(&p, self.form, self.channel) {
+                par_rows(self.threads, 0, r, None, &|first, r: &mut [f64], _| {
+                    for (k, rk) in r.iter_mut().enumerate() {
+                        let i = first + k;
+                        *rk = grad.eval(&self.conds[i], an.factors[i], None) - self.meas[i];
+                    }
+                });
+                return;
+            }
+        }
+        let model = Model::new(p, self.form);
         par_rows(self.threads, 0, r, None, &|first, r: &mut [f64], _| {
             for (k, rk) in r.iter_mut().enumerate() {
                 let i = first + k;
@@ -609,28 +735,68 @@ impl Problem for MfStage<'_> {
         r: &mut [f64],
         jac: &mut DMatrixViewMut<f64>,
     ) {
-        let p = self.params_at(theta);
         if cols.is_empty() {
             self.residuals(theta, r);
             return;
         }
-        // Passes of 16 lanes (the last one of 8 when that suffices): per lane
-        // the 16-lane dual is the cheapest num-dual width for these
-        // equations (wider vectors are slower per lane, see module docs).
+        let Some(rows) = self.row_jacobian(theta, cols) else {
+            return;
+        };
+        par_rows(
+            self.threads,
+            0,
+            r,
+            Some(jac),
+            &|first, r: &mut [f64], jac| {
+                if let Some(jac) = jac {
+                    rows.rows(first, r, jac);
+                }
+            },
+        );
+    }
+    fn weights(&self) -> Option<&[f64]> {
+        self.weights.as_deref()
+    }
+    fn row_jacobian<'s>(
+        &'s self,
+        theta: &[f64],
+        cols: &[usize],
+    ) -> Option<Box<dyn RowJacobian + 's>> {
+        let p = self.params_at(theta);
+        if let Some(an) = &self.analytic {
+            if let Some(grad) = grad_pure::PureGrad::new(&p, self.form, self.channel) {
+                return Some(Box::new(AnalyticRows {
+                    grad,
+                    map: cols.iter().map(|&c| an.local[c]).collect(),
+                    conds: self.conds,
+                    meas: self.meas,
+                    factors: &an.factors,
+                }));
+            }
+        }
+        let mut wide = Vec::new();
+        let mut narrow = None;
         let mut col0 = 0;
         while col0 < cols.len() {
             let rest = &cols[col0..];
             if rest.len() <= 8 {
-                self.jacobian_pass::<8>(&p, rest, col0, r, jac);
+                narrow = Some((col0, rest.len(), self.dual_model::<8>(&p, rest)));
                 col0 += rest.len();
             } else {
                 let chunk = &rest[..rest.len().min(16)];
-                self.jacobian_pass::<16>(&p, chunk, col0, r, jac);
+                wide.push((col0, chunk.len(), self.dual_model::<16>(&p, chunk)));
                 col0 += chunk.len();
             }
         }
+        Some(Box::new(DualRows {
+            wide,
+            narrow,
+            conds: self.conds,
+            meas: self.meas,
+            channel: self.channel,
+        }))
     }
-    fn weights(&self) -> Option<&[f64]> {
-        self.weights.as_deref()
+    fn threads(&self) -> usize {
+        self.threads
     }
 }

@@ -19,7 +19,9 @@
 //! - [`Problem::jacobian`]: r and the exact ∂r/∂θ for the requested columns
 //!   only (`cols`), written column k ↔ `cols[k]` into a column-major view.
 //!   For the Magic Formula: seed a dual number per requested column.
-//! - optionally [`Problem::weights`] (e.g. 1/σ² per channel).
+//! - optionally [`Problem::weights`] (e.g. 1/σ² per channel), and
+//!   [`Problem::row_jacobian`] + [`Problem::threads`]: J by row blocks, so the
+//!   fitter accumulates JᵀJ without storing J (the MF stages do).
 //!
 //! For a model predicting a channel sample by sample, implement
 //! [`SampleModel`] instead and let [`RecordingProblem`] build the problem
@@ -33,6 +35,7 @@
 //! writes `fit.json`. Progress: pass `Some(&mut |p: &Progress| …)`.
 
 pub mod channels;
+pub mod grad_pure;
 pub mod holdout;
 pub mod identify;
 pub mod lm;
@@ -52,7 +55,7 @@ pub use identify::{IdentifyOptions, Verdict};
 pub use lm::{LmOptions, Termination};
 pub use loss::{Loss, LossKind};
 pub use metrics::{ChannelMetric, Condition};
-pub use problem::{Param, Problem, Stack};
+pub use problem::{Param, Problem, RowJacobian, Stack};
 pub use pso::PsoOptions;
 pub use recording::{simulate, RecordingProblem, SampleModel};
 pub use report::FitReport;

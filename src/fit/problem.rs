@@ -96,6 +96,32 @@ pub trait Problem {
     fn weights(&self) -> Option<&[f64]> {
         None
     }
+
+    /// Optional: the linearisation at θ over `cols` row block by row block
+    /// ([`RowJacobian`]), so the fitter can accumulate JᵀΩJ and JᵀΩr block
+    /// by block on [`Problem::threads`] threads without holding the m × n
+    /// Jacobian. `None` (the default): the fitter calls [`Problem::jacobian`].
+    fn row_jacobian<'s>(
+        &'s self,
+        _theta: &[f64],
+        _cols: &[usize],
+    ) -> Option<Box<dyn RowJacobian + 's>> {
+        None
+    }
+
+    /// Threads the fitter may use for [`Problem::row_jacobian`] blocks.
+    fn threads(&self) -> usize {
+        1
+    }
+}
+
+/// A problem's Jacobian at one θ, prepared once ([`Problem::row_jacobian`])
+/// and evaluated by row blocks, possibly from several threads.
+pub trait RowJacobian: Sync {
+    /// r and ∂r/∂θ for the rows `first..first + r.len()`: column k of `jac`
+    /// (r.len() × cols.len(), column-major) ↔ `cols[k]`. Every row must be
+    /// computed exactly as [`Problem::jacobian`] computes it.
+    fn rows(&self, first: usize, r: &mut [f64], jac: &mut DMatrixViewMut<f64>);
 }
 
 /// Check a problem's parameter table and a θ against it: finite starts, lower
@@ -231,6 +257,54 @@ impl Problem for Stack<'_> {
     }
     fn weights(&self) -> Option<&[f64]> {
         self.weights.as_deref()
+    }
+    fn row_jacobian<'s>(
+        &'s self,
+        theta: &[f64],
+        cols: &[usize],
+    ) -> Option<Box<dyn RowJacobian + 's>> {
+        let mut parts = Vec::with_capacity(self.parts.len());
+        let mut off = 0;
+        for (p, _) in &self.parts {
+            parts.push((off, p.row_jacobian(theta, cols)?));
+            off += p.n_residuals();
+        }
+        parts.push((off, Box::new(NoRows)));
+        Some(Box::new(StackRows(parts)))
+    }
+    fn threads(&self) -> usize {
+        self.parts
+            .iter()
+            .map(|(p, _)| p.threads())
+            .max()
+            .unwrap_or(1)
+    }
+}
+
+/// The end marker of [`StackRows`] (never asked for rows).
+struct NoRows;
+
+impl RowJacobian for NoRows {
+    fn rows(&self, _first: usize, _r: &mut [f64], _jac: &mut DMatrixViewMut<f64>) {}
+}
+
+/// The parts' row Jacobians of a [`Stack`] as (first row, part), in order,
+/// ending with the total row count; a block spanning parts is split.
+struct StackRows<'s>(Vec<(usize, Box<dyn RowJacobian + 's>)>);
+
+impl RowJacobian for StackRows<'_> {
+    fn rows(&self, first: usize, r: &mut [f64], jac: &mut DMatrixViewMut<f64>) {
+        let end = first + r.len();
+        for w in self.0.windows(2) {
+            let (a, b) = (w[0].0.max(first), w[1].0.min(end));
+            if a < b {
+                w[0].1.rows(
+                    a - w[0].0,
+                    &mut r[a - first..b - first],
+                    &mut jac.rows_mut(a - first, b - a),
+                );
+            }
+        }
     }
 }
 

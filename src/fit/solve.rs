@@ -25,6 +25,21 @@ pub struct FitOptions {
     /// (final cost, held set, standard errors) is always the full problem's.
     #[serde(default)]
     pub coarse_first: bool,
+    /// Parameters (by name, case-insensitive) held at their start values
+    /// whatever their `free` flag: the user's hold list (`tyrekit fit
+    /// --hold`). Names the problem does not have are ignored here (a staged
+    /// fit checks them against all its stages, see `mf_fit::fit_mf`).
+    #[serde(default)]
+    pub hold: Vec<String>,
+}
+
+impl FitOptions {
+    /// Whether the hold list names parameter `name`.
+    pub fn holds(&self, name: &str) -> bool {
+        self.hold
+            .iter()
+            .any(|h| h.trim().eq_ignore_ascii_case(name))
+    }
 }
 
 /// What is happening, for a progress display.
@@ -167,6 +182,11 @@ pub fn fit_global(
         }
         None => params.iter().map(|p| p.free).collect(),
     };
+    let free_in: Vec<bool> = free_in
+        .iter()
+        .zip(params)
+        .map(|(&f, p)| f && !opts.holds(&p.name))
+        .collect();
     let n_all = params.len();
     let m = problem.n_residuals();
     let loss = opts.lm.loss;
@@ -316,8 +336,15 @@ pub fn fit_global(
             Some(l) => l,
             None => linearise(problem, &theta, &cols0, &loss, &mut ws)?,
         };
-        cost = lin.cost;
-        residual_variance = lin.wrss / (m.saturating_sub(n_free).max(1)) as f64;
+        // The linearisation may be one final step of negligible gain before
+        // θ (see `LmResult::linearisation`): the cost is θ's own, and Σωr²
+        // is scaled to it (exact for plain least squares, where it is 2·cost).
+        let wrss = if lin.cost > 0.0 && cost.is_finite() {
+            lin.wrss * (cost / lin.cost)
+        } else {
+            lin.wrss
+        };
+        residual_variance = wrss / (m.saturating_sub(n_free).max(1)) as f64;
         let keep: Vec<bool> = cols0.iter().map(|&c| free[c]).collect();
         let se = standard_errors(&lin, &keep);
         for (k, &c) in cols0.iter().enumerate() {
@@ -415,11 +442,17 @@ fn polish(
     // Linearisation over cols0 valid at the current θ, if any.
     let mut current: Option<super::lm::Linearisation> = None;
     let mut last_loose = false;
+    // The LM's own linearisation at its solution, when it ended on one over
+    // all of cols0 (saves evaluating J there again).
+    let mut carried: Option<super::lm::Linearisation> = None;
     for round in 0..5 {
         if cols0.is_empty() {
             break;
         }
-        let lin = linearise(problem, &theta, &cols0, &loss, ws)?;
+        let lin = match carried.take() {
+            Some(l) => l,
+            None => linearise(problem, &theta, &cols0, &loss, ws)?,
+        };
         let v = identify(params, &lin, &opts.identify);
         let mut held: Vec<Option<Verdict>> = vec![None; n_all];
         for (k, vk) in v.into_iter().enumerate() {
@@ -479,6 +512,7 @@ fn polish(
         iterations += res.iterations;
         termination = res.termination;
         cost = res.cost;
+        carried = res.linearisation.filter(|l| l.cols == cols0);
     }
 
     if cost == f64::INFINITY {

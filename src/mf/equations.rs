@@ -744,6 +744,18 @@ impl<T: Real> Model<T> {
         gyk * f.fy0 + svyk_unit * f.muy * f.zeta2
     }
 
+    /// The combined-slip factors of [`Model::fy_only`] (Gyκ, SVyκ per unit
+    /// μy·ζ2) and of [`Model::fx_only`] (Gxα): they hold no pure-slip
+    /// coefficient, so the fitter's analytic pure-slip gradients
+    /// (`fit::grad_pure`) compute them once per sample.
+    pub(crate) fn slip_weights(&self, c: &Conditions) -> (T, T, T) {
+        let mut fl = 0u32;
+        let (dfz, _) = self.load_pressure(c);
+        let gs = T::c(c.gamma_star);
+        let (gyk, svyk_unit) = self.gyk(c, dfz, gs * self.lgay, &mut fl);
+        (gyk, svyk_unit, self.gxa(c, dfz, gs * self.lgax, &mut fl))
+    }
+
     /// See [`Model::fx_only`].
     pub(crate) fn mx_only(&self, c: &Conditions) -> T {
         self.mx(c, self.load_pressure(c).1, self.fy_only(c))

@@ -400,7 +400,7 @@ impl Param {
 }
 
 /// How a parametrised candidate applies to one baseline tyre.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct Spec {
     pub params: Vec<Param>,
     /// Values written as they are (not fitted).
@@ -778,12 +778,10 @@ fn relaxation_spec(t: &Tyre, _: &ReplayOptions) -> Option<Spec> {
     };
     Some(Spec {
         params: vec![q(kx).on(&[FX]), q(ky).on(&[FY, MZ])],
-        fixed: vec![],
         kind: Some(TransientKind::Relaxation),
         sequential: true,
-        kappa_re: false,
         prescan: 2,
-        levels: None,
+        ..Spec::default()
     })
 }
 
@@ -816,12 +814,10 @@ fn lugre_spec(t: &Tyre, o: &ReplayOptions) -> Option<Spec> {
             .on(&[FY, MZ]),
             p("MUS", sec("MUS"), 1.0, 0.7, 2.0, 0.01),
         ],
-        fixed: vec![],
         kind: Some(TransientKind::LuGre),
         sequential: true,
-        kappa_re: false,
         prescan: 2,
-        levels: None,
+        ..Spec::default()
     })
 }
 
@@ -835,11 +831,8 @@ fn thermal_spec(_: &Tyre, _: &ReplayOptions) -> Option<Spec> {
             p("MU_T2", vec![th("MU_T2")], 0.0, -1.0, 1.0, 0.002),
         ],
         fixed: vec![(th("COOLING"), 40.0), (th("SHARE"), 0.5)],
-        kind: None,
         sequential: true,
-        kappa_re: false,
-        prescan: 0,
-        levels: None,
+        ..Spec::default()
     })
 }
 
@@ -851,12 +844,7 @@ fn load_spec(_: &Tyre, _: &ReplayOptions) -> Option<Spec> {
             p("MU_DFZ2", l("MU_DFZ2"), 0.0, -0.5, 0.5, 0.002),
             p("K_DFZ1", l("K_DFZ1"), 0.0, -0.5, 0.5, 0.002),
         ],
-        fixed: vec![],
-        kind: None,
-        sequential: false,
-        kappa_re: false,
-        prescan: 0,
-        levels: None,
+        ..Spec::default()
     })
 }
 
@@ -874,12 +862,8 @@ fn pressure_spec(t: &Tyre, _: &ReplayOptions) -> Option<Spec> {
             q("PPY3").on(&[FY, MZ]),
             q("PPY4").on(&[FY, MZ]),
         ],
-        fixed: vec![],
-        kind: None,
-        sequential: false,
-        kappa_re: false,
-        prescan: 0,
         levels: Some((|g| g.p, 5e3)),
+        ..Spec::default()
     })
 }
 
@@ -893,12 +877,7 @@ fn speed_spec(t: &Tyre, _: &ReplayOptions) -> Option<Spec> {
             10.0,
             0.005,
         )],
-        fixed: vec![],
-        kind: None,
-        sequential: false,
-        kappa_re: false,
-        prescan: 0,
-        levels: None,
+        ..Spec::default()
     })
 }
 
@@ -909,12 +888,8 @@ fn radius_spec(t: &Tyre, _: &ReplayOptions) -> Option<Spec> {
             p("Q_RE0", vec![key("Q_RE0")], q, q - 0.1, q + 0.1, 1e-4).on(&[FX]),
             p("FREFF", vec![key("FREFF")], f, f - 2.0, f + 2.0, 2e-3).on(&[FX]),
         ],
-        fixed: vec![],
-        kind: None,
-        sequential: false,
         kappa_re: true,
-        prescan: 0,
-        levels: None,
+        ..Spec::default()
     })
 }
 
@@ -945,12 +920,8 @@ fn camber_spec(t: &Tyre, _: &ReplayOptions) -> Option<Spec> {
             q("QDZ8", 0.005).on(&[MZ]),
             q("QDZ9", 0.005).on(&[MZ]),
         ],
-        fixed: vec![],
-        kind: None,
-        sequential: false,
-        kappa_re: false,
-        prescan: 0,
         levels: Some((|g| g.gamma, 0.5f64.to_radians())),
+        ..Spec::default()
     })
 }
 

@@ -413,6 +413,14 @@ fn rec_err(file: &str, location: impl Into<String>, message: impl Into<String>) 
 pub fn read_raw(path: &Path, format: Option<Format>) -> Result<(RawTable, Format)> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let file = path.display().to_string();
+    // A gzip'd recording (`r01.dat.gz`) is read as the file inside it; the
+    // format is told from the content and the name without `.gz`.
+    let (bytes, inner) = if bytes.starts_with(&[0x1f, 0x8b]) {
+        (gunzip(&bytes, &file)?, path.with_extension(""))
+    } else {
+        (bytes, path.to_path_buf())
+    };
+    let path = inner.as_path();
     let format = match format.or_else(|| Format::detect(path, &bytes)) {
         Some(f) => f,
         None => {
@@ -430,6 +438,29 @@ pub fn read_raw(path: &Path, format: Option<Format>) -> Result<(RawTable, Format
         Format::Csv => csvio::read(&bytes, &file)?,
     };
     Ok((raw, format))
+}
+
+/// Largest size a gzip'd recording may inflate to (bytes): far above any
+/// real test (a million rows of 20 channels is ≈ 200 MB of text), far below
+/// what would exhaust memory.
+pub const GZIP_MAX_INFLATED: u64 = 1 << 30;
+
+/// Inflate a gzip'd recording, refusing one that inflates past
+/// [`GZIP_MAX_INFLATED`] (a decompression bomb) with an error naming the file.
+fn gunzip(bytes: &[u8], file: &str) -> Result<Vec<u8>> {
+    use std::io::Read;
+    let mut out = Vec::new();
+    let mut dec = flate2::read::MultiGzDecoder::new(bytes).take(GZIP_MAX_INFLATED + 1);
+    dec.read_to_end(&mut out)
+        .map_err(|e| rec_err(file, "gzip", format!("cannot inflate: {e}")))?;
+    if out.len() as u64 > GZIP_MAX_INFLATED {
+        return Err(rec_err(
+            file,
+            "gzip",
+            format!("inflates to more than {} MiB; refused", GZIP_MAX_INFLATED >> 20),
+        ));
+    }
+    Ok(out)
 }
 
 /// Read, convert and structure a recording.

@@ -2,24 +2,26 @@
 (vehicle.py) and by run.py (static loads, cone-layout check).
 
 Source of the published values (mass, yaw inertia, axle distances, track, height):
-  X. Zhang et al., "Adaptive Coordinated Path Tracking Control Strategy for
-  Autonomous Vehicles with Direct Yaw Moment Control", Chinese Journal of
-  Mechanical Engineering 35 (2022) 1, Table 4 "The main vehicle parameters",
-  https://doi.org/10.1186/s10033-021-00666-0 (a D-class passenger car):
+  "Adaptive Coordinated Path Tracking Control Strategy for Autonomous Vehicles
+  with Direct Yaw Moment Control", Chinese Journal of Mechanical Engineering
+  (SpringerOpen), Table 4 "The main vehicle parameters",
+  https://doi.org/10.1186/s10033-021-00666-0
+  (https://cjme.springeropen.com/articles/10.1186/s10033-021-00666-0/tables/4):
   m = 1610 kg, Iz = 2059.2 kg m^2, lf = 1.05 m, lr = 1.61 m, track 1.565 m,
   "height of the sprung mass from the roll center" h = 0.65 m.
-The table gives no CG height above ground; we take h_cg = 0.55 m (ASSUMPTION:
-0.65 m above the roll axis minus nothing would be an unusually high sedan; 0.55 m is
-the typical sedan CG height of Gillespie, *Fundamentals of Vehicle Dynamics*, 1992,
-ch. 3). Wheel inertia, wheel radius and brake capacity are ASSUMPTIONS typical of a
-205/60R15 wheel (the built-in tyre of the FMU, Pacejka 3rd ed. App. 3).
+The table gives no CG height above ground (its h = 0.65 m is measured from the roll
+centre), so H_CG = 0.55 m is an ASSUMPTION: a typical sedan value (CG heights of
+passenger cars lie around 0.5-0.6 m), it sets the load transfer when braking and
+cornering. Wheel inertia, loaded wheel radius, brake capacity and the suspension
+figures below are ASSUMPTIONS typical of a car on 205/60R15 wheels (the built-in
+tyre of the FMU, Pacejka, *Tire and Vehicle Dynamics*, 3rd ed., App. 3).
 
 Must never: hold a number twice (vehicle.py and run.py import it from here).
 """
 
 G = 9.81  # m/s^2
 
-MASS = 1610.0  # kg (Zhang et al. 2022, Table 4)
+MASS = 1610.0  # kg (CJME, doi 10.1186/s10033-021-00666-0, Table 4)
 YAW_INERTIA = 2059.2  # kg m^2 (ibid.)
 LF = 1.05  # m, CG to front axle (ibid.)
 LR = 1.61  # m, CG to rear axle (ibid.)

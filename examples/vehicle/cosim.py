@@ -397,7 +397,7 @@ class FmpyMaster:
                 s.do_step(t, h)
             for s in order:
                 s.pull()
-            if record and (k + 1) % record_every == 0:
+            if record and ((k + 1) % record_every == 0 or k + 1 == n_steps):
                 rows.append(self.record((k + 1) * h_ns / 1e9))
         wall = time.perf_counter() - t0
         return np.array(rows), wall

@@ -130,7 +130,7 @@ def plot_slope(out, summary, traces):
     plt.close(fig)
 
 
-def scenario(name, engine, out):
+def scenario(name, engine, out, park=S.SLOPE_PARK):
     out = pathlib.Path(out)
     out.mkdir(parents=True, exist_ok=True)
     tyre, veh = cosim.build_fmus(out / "fmu")
@@ -144,7 +144,7 @@ def scenario(name, engine, out):
         write_csv(out / "trace.csv", cols, [({}, rows)])
         plot_lane_change(out, summary, cols, rows)
     elif name == "slope":
-        summary, traces = S.run_slope(tyre, veh, engine)
+        summary, traces = S.run_slope(tyre, veh, engine, park=park)
         write_csv(out / "trace.csv", traces[0][1], [({"transient": tr}, rows) for tr, _, rows in traces])
         plot_slope(out, summary, traces)
     else:
@@ -179,6 +179,8 @@ def main(argv=None):
     ap.add_argument("--engine", choices=("osp", "fmpy"), default="fmpy")
     ap.add_argument("--scenario", choices=("abs", "lane-change", "slope"))
     ap.add_argument("--out", help="output directory")
+    ap.add_argument("--park", type=float, default=S.SLOPE_PARK,
+                    help="slope: length of the creep window after the car has settled (s, default 60)")
     ap.add_argument("--bench", action="store_true", help="print the real-time factor in both engines")
     ap.add_argument("--bench-seconds", type=float, default=5.0)
     a = ap.parse_args(argv)
@@ -188,7 +190,7 @@ def main(argv=None):
     if not a.scenario or not a.out:
         ap.error("--scenario and --out are required (or --bench)")
     t0 = time.perf_counter()
-    summary = scenario(a.scenario, a.engine, a.out)
+    summary = scenario(a.scenario, a.engine, a.out, a.park)
     print(json.dumps(summary, indent=2))
     print(f"{a.scenario} in {a.engine}: {time.perf_counter() - t0:.1f} s; wrote {a.out}/trace.csv, summary.json, "
           f"{a.scenario}.png")

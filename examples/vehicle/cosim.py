@@ -134,8 +134,9 @@ class System:
             cols += [(f"tyre_{w}", q) for q in TYRE_TRACE]
         return cols
 
-    def write_osp(self, path):
-        """OspSystemStructure.xml (OSP-IS) beside the FMUs it names."""
+    def write_osp(self, path, only=None):
+        """OspSystemStructure.xml (OSP-IS) beside the FMUs it names. only: a subset of
+        instance names (connections among them kept), for the benchmark's breakdown."""
         path = pathlib.Path(path)
         lines = [
             '<?xml version="1.0" encoding="utf-8"?>',
@@ -146,6 +147,8 @@ class System:
             "  <Simulators>",
         ]
         for name, (fmu, start) in self.instances.items():
+            if only is not None and name not in only:
+                continue
             rel = os.path.relpath(fmu, path.parent)
             lines.append(f"    <Simulator name={quoteattr(name)} source={quoteattr(rel)} stepSize={quoteattr(repr(self.step))}>")
             lines.append("      <InitialValues>")
@@ -156,6 +159,8 @@ class System:
         lines.append("  </Simulators>")
         lines.append("  <Connections>")
         for a, av, b, bv in self.connections:
+            if only is not None and not (a in only and b in only):
+                continue
             lines.append("    <VariableConnection>")
             lines.append(f"      <Variable simulator={quoteattr(a)} name={quoteattr(av)}/>")
             lines.append(f"      <Variable simulator={quoteattr(b)} name={quoteattr(bv)}/>")
@@ -186,14 +191,14 @@ def _quiet_libcosim():
 
 
 def run_osp(system, t_end, record_every=10, workdir=None):
-    """Run the system in libcosim; returns (trace array [n, 1 + columns], wall seconds).
-    Row 0 is t = 0 (after initialisation); then one row every `record_every` steps."""
+    """Run the system in libcosim; returns (trace array [n, 1 + columns], wall seconds):
+    one row every `record_every` steps (and at the end). The OspSystemStructure.xml is
+    written to workdir, default the tyre FMU's folder."""
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimObserver import CosimObserver
 
     _quiet_libcosim()
-    workdir = pathlib.Path(workdir or tempfile.mkdtemp(prefix="vehicle-osp-"))
-    osp = system.write_osp(workdir / "OspSystemStructure.xml")
+    osp = system.write_osp(pathlib.Path(workdir or pathlib.Path(system.tyre_fmu).parent) / "OspSystemStructure.xml")
     ex = CosimExecution.from_osp_config_file(str(osp))
     obs = CosimObserver.create_last_value()
     ex.add_observer(obs)
@@ -236,14 +241,17 @@ def run_osp(system, t_end, record_every=10, workdir=None):
     return np.array(rows), wall
 
 
-def bench_osp(system, t_end, workdir=None):
+def bench_osp(system, t_end, workdir=None, only=None):
     """(wall seconds, process CPU seconds, all threads) of libcosim's simulate_until
-    over t_end without observation."""
+    over t_end without observation; only: run just these instances (unconnected
+    inputs stay at their start values)."""
     from libcosimpy.CosimExecution import CosimExecution
 
     _quiet_libcosim()
-    workdir = pathlib.Path(workdir or tempfile.mkdtemp(prefix="vehicle-osp-"))
-    osp = system.write_osp(workdir / "OspSystemStructure.xml")
+    name = "OspSystemStructure.xml" if only is None else "bench-subset/OspSystemStructure.xml"
+    path = pathlib.Path(workdir or pathlib.Path(system.tyre_fmu).parent) / name
+    path.parent.mkdir(parents=True, exist_ok=True)
+    osp = system.write_osp(path, only)
     ex = CosimExecution.from_osp_config_file(str(osp))
     t0, c0 = time.perf_counter(), time.process_time()
     if not ex.simulate_until(int(round(t_end * 1e9))):
@@ -489,9 +497,10 @@ def tyre_probe(tyre_fmu, loads, mu_scale=1.0, side="left"):
 
 
 def profile_fmpy(system, t_end):
-    """Seconds spent in each part of the fmpy master's loop over t_end: the vehicle
-    FMU's three calls (pythonfmu: Python code), the four tyre FMUs' calls, and the
-    loop itself (the timers' own cost is included in 'master loop')."""
+    """CPU seconds of this thread (the fmpy master steps every FMU in its own thread)
+    spent in each part of the loop over t_end: the vehicle FMU's three calls
+    (pythonfmu: Python code), the four tyre FMUs' calls, and the loop itself (the
+    timers' own cost, ~1 us per reading, falls into the parts they bracket)."""
     m = FmpyMaster(system)
     try:
         h = system.step
@@ -500,7 +509,7 @@ def profile_fmpy(system, t_end):
         veh = m.slaves["vehicle"]
         tyres = [s for s in m.order if s is not veh]
         m.initialize()
-        pc = time.perf_counter
+        pc = time.thread_time
         tv = tt = 0.0
         t0 = pc()
         for k in range(n):

@@ -57,18 +57,21 @@ def plot_abs(out, summary, traces):
     for road, tr, cols, rows in traces:
         t = S.col(cols, rows, "t")
         ls = "-" if road == "dry" else "--"
-        ax[0].plot(t, S.col(cols, rows, "vehicle.vx") * 3.6, ls, label=f"{road} {tr}")
-        ax[1].plot(t, S.col(cols, rows, "tyre_fl.kappa"), ls, lw=0.8, label=f"{road} {tr}")
+        kw = dict(color=COLOURS[tr], label=f"{road} {tr}")
+        ax[0].plot(t, S.col(cols, rows, "vehicle.vx") * 3.6, ls, **kw)
         f = S.stop_figures(cols, rows, 0.2)
         k = f["index"]
+        # slip is undefined at standstill: shown up to the stop
+        ax[1].plot(t[:k], S.col(cols, rows, "tyre_fl.kappa")[:k], ls, lw=0.8, **kw)
         ax[2].plot(t[k:] - t[k], 1e3 * (S.col(cols, rows, "vehicle.x")[k:] - S.col(cols, rows, "vehicle.x")[k]), ls,
-                   label=f"{road} {tr}")
+                   **kw)
     ax[0].set_ylabel("speed (km/h)")
     ax[0].set_title("ABS stop from 100 km/h (1 ms co-simulation, 4 TyreKit FMUs + vehicle FMU)")
-    ax[1].set_ylabel("front-left slip kappa")
+    ax[1].set_ylabel("front-left slip kappa (to the stop)")
     ax[1].set_xlabel("time (s)")
     ax[1].set_ylim(-0.4, 0.1)
     ax[2].set_ylabel("position after stop (mm)")
+    ax[2].set_ylim(-60, 200)
     ax[2].set_xlabel("time after stop (s)")
     for a in ax:
         a.grid(True, alpha=0.3)
@@ -106,6 +109,9 @@ def plot_lane_change(out, summary, cols, rows):
     plt.close(fig)
 
 
+COLOURS = {"steady": "tab:blue", "relaxation": "tab:orange", "lugre": "tab:green"}
+
+
 def plot_slope(out, summary, traces):
     plt = _plt()
     fig, ax = plt.subplots(2, 1, figsize=(8, 7), dpi=80)
@@ -115,9 +121,11 @@ def plot_slope(out, summary, traces):
         if f is None:
             continue
         k = f["index"]
-        ax[0].plot(t[k:] - t[k], 1e3 * (x[k:] - x[k]), label=tr)
+        ax[0].plot(t[k:] - t[k], 1e3 * (x[k:] - x[k]), color=COLOURS[tr], label=tr)
         if tr != "steady":
-            ax[1].plot(t[k:] - t[k], 1e3 * (x[k:] - x[k]), label=f"{tr}: creep {r['creep_mm']:.3f} mm")
+            ax[1].plot(t[k:] - t[k], 1e3 * (x[k:] - x[k]), color=COLOURS[tr],
+                       label=f"{tr}: creep {r['creep_mm']:.4f} mm from {summary['settle_s']:.0f} s to "
+                             f"{summary['settle_s'] + r['creep_window_s']:.0f} s")
     ax[0].set_title("Parked facing down a 15 % grade after an ABS stop")
     ax[0].set_ylabel("travel after stop (mm)")
     ax[1].set_ylabel("travel after stop (mm)")
@@ -156,8 +164,10 @@ def scenario(name, engine, out, park=S.SLOPE_PARK):
 def bench(seconds=5.0, workdir=None):
     """Real-time factor (simulated / wall time) of the whole system at 1 ms in both
     engines, and where the time goes in the fmpy master."""
-    workdir = pathlib.Path(workdir or tempfile.mkdtemp(prefix="vehicle-bench-"))
-    tyre, veh = cosim.build_fmus(workdir)
+    if workdir is None:
+        with tempfile.TemporaryDirectory(prefix="vehicle-bench-") as tmp:
+            return bench(seconds, tmp)
+    tyre, veh = cosim.build_fmus(pathlib.Path(workdir))
     probe = cosim.tyre_probe(tyre, car.static_loads(), 1.0)
     system = cosim.System(tyre, veh, S.abs_vehicle(probe), {"transient": "relaxation"}, 1.0, S.STEP)
     res = {}
@@ -168,9 +178,13 @@ def bench(seconds=5.0, workdir=None):
         res[engine] = {"rtf_wall": seconds / wall, "rtf_cpu": seconds / cpu}
         print(f"{engine:5s}: {seconds:.1f} s simulated at 1 ms in {wall:.3f} s wall, {cpu:.3f} s CPU (best of 3): "
               f"real-time factor {seconds / wall:.1f} (wall), {seconds / cpu:.1f} (CPU of all threads)")
+    for label, only in (("vehicle FMU alone", ["vehicle"]), ("4 tyre FMUs alone", [f"tyre_{w}" for w in car.WHEELS])):
+        wall, cpu = min(cosim.bench_osp(system, seconds, only=only) for _ in range(3))
+        print(f"osp, {label}: {1e6 * cpu / (seconds / S.STEP):.1f} us CPU per step (real-time factor "
+              f"{seconds / wall:.1f} wall, {seconds / cpu:.1f} CPU)")
     prof = cosim.profile_fmpy(system, seconds)
     n = int(round(seconds / S.STEP))
-    print("fmpy master, per step: " + ", ".join(f"{k} {1e6 * v / n:.1f} us" for k, v in prof.items()))
+    print("fmpy master, CPU per step: " + ", ".join(f"{k} {1e6 * v / n:.1f} us" for k, v in prof.items()))
     return res, prof
 
 

@@ -6,8 +6,8 @@ Model (ISO 8855 vehicle axes: x forward, y left, z up; SI units):
 - planar body: position X, Y, yaw psi; body velocities u, v; yaw rate r. Newton-Euler
   in the moving frame, m(u' - v r) = sum Fx_b + m g sin(theta) (grade, car facing
   downhill), m(v' + u r) = sum Fy_b, Iz r' = sum(x_i Fy_b,i - y_i Fx_b,i) + sum Mz_i
-  (e.g. Rajamani, *Vehicle Dynamics and Control*, 2nd ed., eqs. 2.1-2.3 and 4.x for
-  the two-track sums);
+  (the textbook planar vehicle model, e.g. Pacejka, *Tire and Vehicle Dynamics*,
+  3rd ed., ch. 1, there for one track; here with the four wheels' positions);
 - four wheel-spin degrees of freedom, Iw omega' = My - Rw Fx + Td - Tb sign(omega),
   the brake as a Coulomb friction torque that holds a stopped wheel (stick-slip as in
   tyrekit's transient/scenario.rs);
@@ -47,6 +47,8 @@ import car
 import iso3888
 
 SCENARIOS = ("abs", "lane-change", "slope", "coast")
+# output names per wheel, built once (the step runs at 1 kHz in Python)
+_OUT = tuple(tuple(f"{q}_{w}" for q in ("vx", "vy", "omega", "Fz", "gamma", "Tb")) for w in car.WHEELS)
 
 
 class Vehicle(Fmi2Slave):
@@ -116,6 +118,7 @@ class Vehicle(Fmi2Slave):
         self._tb = [0.0] * 4
         self._xi = [0.0] * 4  # wheel-centre recession (m, + = forward of design)
         self._xidot = [0.0] * 4
+        self._vxw = [0.0] * 4  # wheel-frame vx sent to the tyres (the ABS reads it)
         # filtered tyre force sums (N) for the load transfer: start at the static state
         self._sfx = 0.0
         self._sfy = 0.0
@@ -135,25 +138,27 @@ class Vehicle(Fmi2Slave):
             w * car.LF / L / 2 - dpitch + droll * car.LF / L,
         )
         u, v, r = self.vx, self.vy, self.yaw_rate
-        for i, name in enumerate(car.WHEELS):
+        for i in range(4):
+            n_vx, n_vy, n_om, n_fz, n_ga, n_tb = _OUT[i]
             vxb = u - r * car.POS_Y[i] + self._xidot[i]
             vyb = v + r * car.POS_X[i]
             if i < 2:  # steered: body -> wheel frame, rotation by -delta
                 vxw, vyw = c * vxb + s * vyb, -s * vxb + c * vyb
             else:
                 vxw, vyw = vxb, vyb
-            setattr(self, "vx_" + name, vxw)
-            setattr(self, "vy_" + name, vyw)
-            setattr(self, "omega_" + name, self._omega[i])
-            setattr(self, "Fz_" + name, max(fz[i], 0.0))
-            setattr(self, "gamma_" + name, 0.0)
-            setattr(self, "Tb_" + name, self._tb[i])
+            self._vxw[i] = vxw
+            setattr(self, n_vx, vxw)
+            setattr(self, n_vy, vyw)
+            setattr(self, n_om, self._omega[i])
+            setattr(self, n_fz, fz[i] if fz[i] > 0.0 else 0.0)
+            setattr(self, n_ga, 0.0)
+            setattr(self, n_tb, self._tb[i])
 
     # ------------------------------------------------------------------ controllers
 
     def _steer(self):
-        """Path follower (Stanley controller, Hoffmann et al., ACC 2007, eq. 2, at the
-        front axle) with a curvature feed-forward previewed `preview` s ahead:
+        """Path follower (the Stanley controller of Hoffmann, Tomlin, Montemerlo and
+        Thrun, American Control Conference 2007, at the front axle) with a curvature feed-forward previewed `preview` s ahead:
         delta = L kappa_ref(x_f + u T) + (theta_ref - psi) + atan(k e / u)."""
         b = car.WIDTH
         cp, sp = math.cos(self.psi), math.sin(self.psi)
@@ -210,8 +215,7 @@ class Vehicle(Fmi2Slave):
             for i in range(4):
                 avail = ramp * (car.BRAKE_MAX_FRONT if i < 2 else car.BRAKE_MAX_REAR)
                 if abs_on:
-                    vxw = getattr(self, "vx_" + car.WHEELS[i])
-                    target = (1.0 - self.abs_slip) * vxw / self.rolling_radius
+                    target = (1.0 - self.abs_slip) * self._vxw[i] / self.rolling_radius
                     spin = (1.0 - self.abs_slip) * udot / self.rolling_radius
                     want = My[i] - rw * Fx[i] - iw * spin + iw * (self._omega[i] - target) / 0.02
                     tb[i] = min(max(want, 0.0), avail)

@@ -100,6 +100,9 @@ def test_both_engines_run_and_agree(runs, scenario, extra):
         assert (d / "trace.csv").stat().st_size > 0
         assert (d / f"{scenario}.png").stat().st_size > 10_000
     assert_engines_agree(da, db)
+    # libcosim ran from the system structure file written beside the FMUs
+    osp = (db / "fmu" / "OspSystemStructure.xml").read_text()
+    assert osp.count("<Simulator ") == 5 and osp.count("<VariableConnection>") == 4 * (5 + 4)
 
 
 def mu_peak_by_eval(tmp_path):
@@ -195,3 +198,34 @@ def test_slope_relaxation_and_lugre_hold_steady_creeps(runs):
         assert abs(r[tr]["creep_mm"]) < 1.0, r[tr]
         assert r[tr]["max_speed_parked_mps"] < 1e-3, r[tr]
     assert r["steady"]["creep_mm"] > 10.0, r["steady"]
+
+
+def test_vehicle_loads_and_iso_w_signs(runs):
+    """The vehicle FMU's interface physics, from the traces: the normal loads carry the
+    weight exactly (flat road); while braking the front axle gains h*|sum Fx|/L (the
+    quasi-static transfer, its 50 ms lag long settled at mid-stop; 1 % for the slowly
+    changing deceleration); braking is Fx < 0 at kappa < 0 (ISO-W); in the left turn
+    of the lane change (largest positive yaw rate) every tyre pushes left (Fy > 0) and
+    the right-hand (outer) wheels carry more load."""
+    _, d = runs("fmpy", "abs")
+    head, labels, a = read_trace(d / "trace.csv")
+    c = {n: a[:, i] for i, n in enumerate(head)}
+    m = np.array([lab == ("dry", "relaxation") for lab in labels])
+    fz = sum(c[f"vehicle.Fz_{w}"][m] for w in car.WHEELS)
+    np.testing.assert_allclose(fz, car.MASS * car.G, rtol=1e-12)
+    i = int(np.argmin(np.abs(c["t"][m] - 1.5)))
+    fx = sum(c[f"tyre_{w}.Fx"][m][i] for w in car.WHEELS)
+    static = car.static_loads()
+    gain = c["vehicle.Fz_fl"][m][i] + c["vehicle.Fz_fr"][m][i] - static[0] - static[1]
+    assert gain == pytest.approx(-car.H_CG * fx / car.WHEELBASE, rel=0.01)
+    for w in car.WHEELS:
+        assert c[f"tyre_{w}.Fx"][m][i] < -1000 and c[f"tyre_{w}.kappa"][m][i] < 0
+
+    _, d = runs("fmpy", "lane-change")
+    head, _, a = read_trace(d / "trace.csv")
+    c = {n: a[:, i] for i, n in enumerate(head)}
+    i = int(np.argmax(c["vehicle.yaw_rate"]))
+    assert c["vehicle.yaw_rate"][i] > 0.2
+    for w in car.WHEELS:
+        assert c[f"tyre_{w}.Fy"][i] > 0, w
+    assert c["vehicle.Fz_fr"][i] > c["vehicle.Fz_fl"][i] and c["vehicle.Fz_rr"][i] > c["vehicle.Fz_rl"][i]

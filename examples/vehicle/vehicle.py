@@ -96,6 +96,31 @@ class Vehicle(Fmi2Slave):
             self.register_variable(Real(f"Tb_{w}", causality=Fmi2Causality.output))
         for q in ("x", "y", "psi", "vx", "vy", "yaw_rate", "ax", "ay", "delta", "time"):
             self.register_variable(Real(q, causality=Fmi2Causality.output))
+        # Real value reference -> attribute name (every Real reads as an attribute;
+        # inputs are written as attributes, parameters through _set_param)
+        self._real_names = {vr: v.name for vr, v in self.vars.items() if isinstance(v, Real)}
+        self._real_inputs = {vr: v.name for vr, v in self.vars.items()
+                             if isinstance(v, Real) and v.causality == Fmi2Causality.input}
+
+    # pythonfmu's get_real/set_real call a lambda per value and type-check each one;
+    # at 1 kHz with 16 inputs and 20 outputs that was a third of the FMU's cost.
+    def get_real(self, vrs):
+        names = self._real_names
+        try:
+            return [getattr(self, names[vr]) for vr in vrs]
+        except KeyError as e:
+            raise TypeError(f"Variable with valueReference={e.args[0]} is not of type Real!") from None
+
+    def set_real(self, vrs, values):
+        inputs = self._real_inputs
+        for vr, value in zip(vrs, values):
+            name = inputs.get(vr)
+            if name is not None:
+                setattr(self, name, value)
+            elif vr in self._real_names:
+                self._set_param(self._real_names[vr], value)
+            else:
+                raise TypeError(f"Variable with valueReference={vr} is not of type Real!")
 
     # ------------------------------------------------------------------ set-up
 

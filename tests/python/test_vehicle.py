@@ -95,7 +95,7 @@ def assert_engines_agree(dir_a, dir_b):
 
 @pytest.mark.parametrize("scenario,extra", [("abs", ()), ("lane-change", ()), ("slope", ("--park", str(SLOPE_TEST_PARK)))])
 def test_both_engines_run_and_agree(runs, scenario, extra):
-    (sa, da), (sb, db) = runs("fmpy", scenario, *extra), runs("osp", scenario, *extra)
+    (_, da), (_, db) = runs("fmpy", scenario, *extra), runs("osp", scenario, *extra)
     for d in (da, db):
         assert (d / "trace.csv").stat().st_size > 0
         assert (d / f"{scenario}.png").stat().st_size > 10_000

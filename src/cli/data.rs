@@ -6,9 +6,10 @@ use crate::data::{self, Format, LoadOptions, Loaded, ReChoice, SegmentKind};
 use crate::error::{Error, Result};
 use std::path::PathBuf;
 
-/// Options shared by the `data` subcommands: how to read a recording.
+/// How to read a recording: the flags `data`, `fit`, `diagnose` and `replay`
+/// share (one definition, flattened into each command).
 #[derive(clap::Args, Debug, Clone, Default)]
-pub struct ReadArgs {
+pub struct RecordingArgs {
     /// Force the format instead of detecting it: mat | dat | tdx | csv.
     #[arg(long)]
     pub format: Option<String>,
@@ -16,25 +17,19 @@ pub struct ReadArgs {
     /// (default: SAE for TTC files, TYDEX W for .tdx, ISO-W for CSV).
     #[arg(long)]
     pub axes: Option<String>,
-    /// Effective rolling radius for κ = Ω·Re/(V·cos α) − 1: free-rolling
-    /// (default: Re(Fz) fitted on free-rolling samples), recorded, loaded, or
-    /// model (needs --tir).
+    /// Effective rolling radius for κ = Ω·Re/(V·cos α) − 1 where κ is computed
+    /// from wheel speed: free-rolling (Re(Fz) fitted on the recording's
+    /// free-rolling samples), recorded, loaded, or model (the Re(Fz) of the
+    /// command's tyre file: --tir, or --start for fit). Default: model where
+    /// `diagnose` is given --tir, else free-rolling.
     #[arg(long)]
     pub re: Option<String>,
-    /// Tyre property file for --re model.
-    #[arg(long)]
-    pub tir: Option<PathBuf>,
-    /// Always compute κ from wheel speed, even when the file records it.
-    #[arg(long)]
-    pub compute_kappa: bool,
-    /// Keep the warm-up (do not detect and cut it).
-    #[arg(long)]
-    pub keep_warmup: bool,
 }
 
-impl ReadArgs {
-    /// Loader options from the flags.
-    pub fn options(&self) -> Result<LoadOptions> {
+impl RecordingArgs {
+    /// Loader options from the flags; `tyre` is the tyre `--re model` uses
+    /// (None: `--re model` is an error naming `tyre_flag`).
+    pub fn options(&self, tyre: Option<&crate::mf::Tyre>, tyre_flag: &str) -> Result<LoadOptions> {
         let mut o = LoadOptions::default();
         if let Some(f) = &self.format {
             o.format = Some(Format::parse(f).ok_or_else(|| {
@@ -49,12 +44,10 @@ impl ReadArgs {
             })?);
         }
         if let Some(r) = &self.re {
-            o.re = if r.eq_ignore_ascii_case("model") {
-                let tir = self
-                    .tir
-                    .as_ref()
-                    .ok_or_else(|| Error::Input("--re model needs --tir FILE".into()))?;
-                ReChoice::Model(Box::new(crate::mf::Tyre::from_file(tir)?))
+            o.re = if r.trim().eq_ignore_ascii_case("model") {
+                let t =
+                    tyre.ok_or_else(|| Error::Input(format!("--re model needs {tyre_flag} FILE")))?;
+                ReChoice::Model(Box::new(t.clone()))
             } else {
                 ReChoice::parse(r).ok_or_else(|| {
                     Error::Input(format!(
@@ -63,6 +56,49 @@ impl ReadArgs {
                 })?
             };
         }
+        Ok(o)
+    }
+}
+
+/// Load every recording with `o`, printing each rejected channel as a
+/// warning on stderr (prefixed by the command's name).
+pub fn load_all(paths: &[PathBuf], o: &LoadOptions, cmd: &str) -> Result<Vec<data::Recording>> {
+    let mut out = Vec::with_capacity(paths.len());
+    for p in paths {
+        let l = data::load(p, o)?;
+        for r in &l.report.rejected {
+            eprintln!("tyrekit {cmd}: warning: {}: {r}", p.display());
+        }
+        out.push(l.recording);
+    }
+    Ok(out)
+}
+
+/// Options of the `data` subcommands: how to read a recording.
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct ReadArgs {
+    #[command(flatten)]
+    pub rec: RecordingArgs,
+    /// Tyre property file for --re model.
+    #[arg(long)]
+    pub tir: Option<PathBuf>,
+    /// Always compute κ from wheel speed, even when the file records it.
+    #[arg(long)]
+    pub compute_kappa: bool,
+    /// Keep the warm-up (do not detect and cut it).
+    #[arg(long)]
+    pub keep_warmup: bool,
+}
+
+impl ReadArgs {
+    /// Loader options from the flags.
+    pub fn options(&self) -> Result<LoadOptions> {
+        let tyre = self
+            .tir
+            .as_ref()
+            .map(|t| crate::mf::Tyre::from_file(t))
+            .transpose()?;
+        let mut o = self.rec.options(tyre.as_ref(), "--tir")?;
         if self.compute_kappa {
             o.kappa = data::KappaSource::Computed;
         }
@@ -265,6 +301,9 @@ pub fn summary_text(l: &Loaded) -> String {
     }
     for n in &p.notes {
         let _ = writeln!(s, "note: {n}");
+    }
+    for n in &p.rejected {
+        let _ = writeln!(s, "warning: {n}");
     }
     let _ = writeln!(s, "\ntest matrix: {} segments", r.segments.len());
     let _ = writeln!(

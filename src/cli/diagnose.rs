@@ -9,7 +9,7 @@
 //! Must never: panic on bad input (errors name the file or flag), or draw
 //! progress when stderr is not a terminal.
 
-use crate::data::{load, LoadOptions, ReChoice};
+use crate::data::ReChoice;
 use crate::diagnose::baseline::{drop_unfitted, fit_baseline, HELD_PRESSURE_KEYS};
 use crate::diagnose::replay::ReplayOptions;
 use crate::diagnose::report::{diagnose_with, merge};
@@ -33,14 +33,13 @@ pub struct Args {
     /// Baseline tyre (.tir). Default: fit the steady MF 6.1 to the recordings.
     #[arg(long)]
     pub tir: Option<PathBuf>,
-    /// Effective rolling radius for κ = Ω·Re/(V·cos α) − 1 where κ is computed
-    /// from wheel speed: model (the baseline's Re(Fz); the default with --tir),
-    /// free-rolling (Re(Fz) fitted on the recording's free-rolling samples; the
-    /// default without --tir), recorded or loaded. With --tir, `free-rolling`
-    /// would absorb part of a rolling-radius effect into κ before the
-    /// diagnosis sees it, and leaves a load-dependent κ bias of its own.
-    #[arg(long)]
-    pub re: Option<String>,
+    /// How to read the recordings. `--re`: model (the baseline's Re(Fz); the
+    /// default with --tir), free-rolling (the default without --tir), recorded
+    /// or loaded. With --tir, `free-rolling` would absorb part of a
+    /// rolling-radius effect into κ before the diagnosis sees it, and leaves a
+    /// load-dependent κ bias of its own.
+    #[command(flatten)]
+    pub read: crate::cli::data::RecordingArgs,
 }
 
 fn bar(len: u64, template: &str) -> Option<ProgressBar> {
@@ -66,26 +65,17 @@ pub fn run(a: Args) -> Result<()> {
         }
     }
     let given = a.tir.as_ref().map(|t| Tyre::from_file(t)).transpose()?;
-    let re = match (a.re.as_deref(), &given) {
-        (None | Some("model"), Some(t)) => ReChoice::Model(Box::new(t.clone())),
-        (None, None) => ReChoice::FreeRolling,
-        (Some("model"), None) => {
-            return Err(Error::Input("--re model needs --tir FILE".into()));
-        }
-        (Some(r), _) => ReChoice::parse(r).ok_or_else(|| {
-            Error::Input(format!(
-                "--re '{r}': expected model, free-rolling, recorded or loaded"
-            ))
-        })?,
-    };
-    let opts = LoadOptions {
-        re,
-        ..Default::default()
-    };
-    let mut recs: Vec<crate::data::Recording> = Vec::new();
-    for p in &a.recordings {
-        recs.push(load(p, &opts)?.recording);
+    let mut opts = a.read.options(given.as_ref(), "--tir")?;
+    if a.read.re.is_none() {
+        opts.re = match &given {
+            Some(t) => ReChoice::Model(Box::new(t.clone())),
+            None => ReChoice::FreeRolling,
+        };
     }
+    let mut recs = crate::cli::data::load_all(&a.recordings, &opts, "diagnose")?;
+    let mut inputs = a.recordings.clone();
+    inputs.extend(a.tir.iter().cloned());
+    let mut prov = crate::tir::provenance::Provenance::of_inputs(&inputs)?;
     std::fs::create_dir_all(&a.report).map_err(|e| Error::io(&a.report, e))?;
     let (tyre, note) = match (&a.tir, given) {
         (Some(tir), Some(t)) => (
@@ -110,6 +100,13 @@ pub fn run(a: Args) -> Result<()> {
             for s in &fit.skipped {
                 eprintln!("tyrekit diagnose: baseline fit stage skipped: {s}");
             }
+            if fit.report.stages.is_empty() {
+                return Err(Error::Input(format!(
+                    "diagnose: the baseline fit found no usable data in any stage ({}): the recording cannot be analysed",
+                    fit.skipped.join("; ")
+                )));
+            }
+            prov.lines = crate::cli::provenance::report_lines(&fit.report);
             let sig = |ch: &str| {
                 crate::fit::mf_fit::overall_sigma(&fit.report.metrics, ch)
                     .map_or("–".into(), |v| format!("{:.1} %", 100.0 * v))
@@ -148,8 +145,13 @@ pub fn run(a: Args) -> Result<()> {
         }
     };
     let d = diagnose_with(&rec, &tyre, &ReplayOptions::default(), &mut step)?;
-    tyre.params().write(&a.report.join("baseline.tir"))?;
-    d.extended.params().write(&a.report.join("extended.tir"))?;
+    let mut base = tyre.params().clone();
+    prov.stamp(&mut base);
+    base.write(&a.report.join("baseline.tir"))?;
+    let mut ext = d.extended.params().clone();
+    prov.lines.push(format!("diagnosis verdict: {}", d.verdict));
+    prov.stamp(&mut ext);
+    ext.write(&a.report.join("extended.tir"))?;
     let pl = plots::draw_all(&rec, &d, &a.report)?;
     if let Some(b) = &steps {
         b.finish_and_clear();

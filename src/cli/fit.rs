@@ -48,6 +48,9 @@ pub struct Args {
     /// (e.g. PKY4,PEY3); a key no stage fits is an error.
     #[arg(long, value_delimiter = ',')]
     pub hold: Vec<String>,
+    /// How to read the recordings (`--re model` uses the start tyre).
+    #[command(flatten)]
+    pub read: crate::cli::data::RecordingArgs,
 }
 
 fn parse_model(s: &str) -> Result<MfVersion> {
@@ -84,6 +87,7 @@ pub fn run(args: Args) -> Result<()> {
         opts.only = only;
     }
     opts.fit.hold = args.hold.clone();
+    opts.geometry = true;
     let mut start = match &args.start {
         Some(p) => {
             opts.nominal_from_data = false;
@@ -94,11 +98,11 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(m) = &args.model {
         start.version = parse_model(m)?;
     }
-    let recs: Vec<Recording> = args
-        .recordings
-        .iter()
-        .map(|p| Recording::from_file(p))
-        .collect::<Result<_>>()?;
+    let start_tyre = (args.read.re.is_some())
+        .then(|| Tyre::new(start.clone()))
+        .transpose()?;
+    let load = args.read.options(start_tyre.as_ref(), "--start")?;
+    let recs: Vec<Recording> = crate::cli::data::load_all(&args.recordings, &load, "fit")?;
 
     let bar = std::io::stderr().is_terminal().then(|| {
         let b = indicatif::ProgressBar::new(100);
@@ -120,9 +124,25 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    res.tyre.write(&args.out)?;
     for s in &res.skipped {
         eprintln!("tyrekit fit: stage skipped: {s}");
+    }
+    if res.report.stages.is_empty() && res.report.relaxation.is_empty() {
+        return Err(Error::Input(format!(
+            "fit: no stage had usable data ({}); nothing written to {}",
+            res.skipped.join("; "),
+            args.out.display()
+        )));
+    }
+    let mut tyre = res.tyre.clone();
+    let mut inputs = args.recordings.clone();
+    inputs.extend(args.start.iter().cloned());
+    crate::cli::provenance::stamp_fit(&mut tyre, &inputs, &res)?;
+    tyre.write(&args.out)?;
+    if let Some(g) = &res.geometry {
+        for l in g.lines() {
+            println!("{l}");
+        }
     }
     print!("{}", res.report.to_text());
     println!("wrote {}", args.out.display());

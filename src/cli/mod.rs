@@ -12,6 +12,7 @@ pub mod diagnose;
 pub mod eval;
 pub mod fit;
 pub mod package;
+pub mod provenance;
 pub mod replay;
 
 /// tyrekit: a Magic Formula tyre model, its FMI 2.0 FMU, fitting and diagnosis.

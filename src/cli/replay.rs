@@ -27,6 +27,9 @@ pub struct Args {
     /// MFeval use mode (hundreds limits 1 on/2 off, tens α* 1 off/2 on, units turn slip).
     #[arg(long, default_value_t = 111)]
     pub use_mode: u32,
+    /// How to read the recording (`--re model` uses --tir's Re(Fz)).
+    #[command(flatten)]
+    pub read: crate::cli::data::RecordingArgs,
 }
 
 /// Run the command.
@@ -44,7 +47,9 @@ pub fn run(a: Args) -> Result<()> {
         ))
     })?;
     let tyre = Tyre::from_file(&a.tir)?;
-    let rec = crate::data::Recording::from_file(&a.recording)?;
+    let load = a.read.options(Some(&tyre), "--tir")?;
+    let rec =
+        crate::cli::data::load_all(std::slice::from_ref(&a.recording), &load, "replay")?.remove(0);
     let opts = ReplayOptions {
         kind,
         use_mode,

@@ -15,6 +15,7 @@ pub mod conventions;
 pub mod csvio;
 pub mod mat;
 pub mod plot;
+pub mod sanity;
 pub mod slip;
 pub mod structure;
 pub mod tdx;
@@ -390,6 +391,9 @@ pub struct LoadReport {
     pub warmup: Option<structure::WarmupCut>,
     /// Other remarks (unknown units of extra channels, time going backwards …).
     pub notes: Vec<String>,
+    /// Channels rejected as broken, each with the reason (their values are
+    /// NaN, the rows kept: [`sanity`]).
+    pub rejected: Vec<String>,
     /// File metadata (TTC source/testid/tireid, TYDEX header).
     pub meta: Vec<(String, String)>,
 }
@@ -457,7 +461,10 @@ fn gunzip(bytes: &[u8], file: &str) -> Result<Vec<u8>> {
         return Err(rec_err(
             file,
             "gzip",
-            format!("inflates to more than {} MiB; refused", GZIP_MAX_INFLATED >> 20),
+            format!(
+                "inflates to more than {} MiB; refused",
+                GZIP_MAX_INFLATED >> 20
+            ),
         ));
     }
     Ok(out)
@@ -555,6 +562,25 @@ const ALIASES: &[(Ch, Dim, &[&str])] = &[
     (Ch::Mz, Dim::Moment, &["mz", "mzw", "mzc", "mz_w"]),
 ];
 
+/// Sample channel name of each core channel (road speed V stands for Vx).
+const CH_NAMES: [(Ch, &str); 15] = [
+    (Ch::Time, "time"),
+    (Ch::Vx, "Vx"),
+    (Ch::Speed, "Vx"),
+    (Ch::Omega, "omega"),
+    (Ch::Fz, "Fz"),
+    (Ch::Kappa, "kappa"),
+    (Ch::Alpha, "alpha"),
+    (Ch::Gamma, "gamma"),
+    (Ch::Phit, "phit"),
+    (Ch::P, "P"),
+    (Ch::Fx, "Fx"),
+    (Ch::Fy, "Fy"),
+    (Ch::Mx, "Mx"),
+    (Ch::My, "My"),
+    (Ch::Mz, "Mz"),
+];
+
 /// Known extra channels and their dimension (radii, slips, temperatures).
 fn extra_dim(name: &str) -> Option<Dim> {
     let n = name.to_ascii_lowercase();
@@ -624,6 +650,7 @@ pub fn from_raw(raw: RawTable, format: Format, file: &str, opts: &LoadOptions) -
     }
     // Identify the core channels; everything else is extra.
     let mut core: Vec<(Ch, Vec<f64>)> = Vec::new();
+    let mut core_units: Vec<(Ch, Option<String>)> = Vec::new();
     let mut extra: Vec<(String, Vec<f64>)> = Vec::new();
     for col in &raw.columns {
         let (name, hdr_unit) = units::split_header(&col.name);
@@ -681,6 +708,7 @@ pub fn from_raw(raw: RawTable, format: Format, file: &str, opts: &LoadOptions) -
                 .map(|&x| x * conv.scale + conv.offset)
                 .collect();
             core.push((ch, data));
+            core_units.push((ch, unit.clone()));
         } else {
             let ename = extra_name(&name);
             let mut data = col.data[..n].to_vec();
@@ -808,12 +836,27 @@ pub fn from_raw(raw: RawTable, format: Format, file: &str, opts: &LoadOptions) -
         ));
     }
 
+    // Sign and unit slips stop here; broken channels are rejected (rows kept).
+    let unit_of = |name: &str| {
+        let ch = CH_NAMES.iter().find(|(_, n)| *n == name)?.0;
+        core_units.iter().find(|(c, _)| *c == ch)?.1.clone()
+    };
+    sanity::check_conventions(&samples, &channels, axes, &unit_of, file)?;
+    sanity::check_wheel_speed(&mut samples, &mut channels, &mut report);
+    sanity::check_radii(&samples, &mut extra, &mut report);
+    sanity::check_pinned_slip(&mut samples, &mut channels, &mut extra, &mut report);
+    let has_kappa = channels.iter().any(|c| c == "kappa");
+    let rl_col = extra
+        .iter()
+        .find(|(nm, _)| nm == "Rl")
+        .map(|(_, v)| v.clone());
+
     // κ from wheel speed, if asked or needed (before the row filter so that
     // non-finite κ is counted as a dropped row).
     let want_computed = match opts.kappa {
         KappaSource::Computed => true,
         KappaSource::Recorded => false,
-        KappaSource::Auto => !has(Ch::Kappa),
+        KappaSource::Auto => !has_kappa,
     };
     if want_computed {
         let re = extra
@@ -821,9 +864,15 @@ pub fn from_raw(raw: RawTable, format: Format, file: &str, opts: &LoadOptions) -
             .find(|(nm, _)| nm == "Re")
             .map(|(_, v)| v.as_slice());
         let rl = rl_col.as_deref();
-        match slip::compute_kappa(&mut samples, re, rl, &opts.re) {
+        let omega_ok = channels.iter().any(|c| c == "omega");
+        let computed = if omega_ok {
+            slip::compute_kappa(&mut samples, re, rl, &opts.re)
+        } else {
+            None
+        };
+        match computed {
             Some(how) => {
-                if has(Ch::Kappa) {
+                if has_kappa {
                     report
                         .notes
                         .push("recorded κ replaced by κ computed from wheel speed".into());
@@ -833,11 +882,20 @@ pub fn from_raw(raw: RawTable, format: Format, file: &str, opts: &LoadOptions) -
                     channels.push("kappa".into());
                 }
             }
+            // A rejected (broken) wheel speed or κ on a freely rolling run.
+            None if !has_kappa
+                && (has(Ch::Omega) || has(Ch::Kappa))
+                && sanity::free_rolling_run(&samples, channels.iter().any(|c| c == "Fx")) =>
+            {
+                samples.iter_mut().for_each(|s| s.kappa = 0.0);
+                channels.push("kappa".into());
+                report.kappa = "κ = 0: no usable wheel speed, and the run rolls freely (|Fx| < 10 % Fz on 95 % of the loaded rows)".into();
+            }
             None => {
-                report.kappa = "missing (no wheel speed / radius to compute it)".into();
+                report.kappa = "missing (no usable wheel speed / radius to compute it)".into();
             }
         }
-    } else if has(Ch::Kappa) {
+    } else if has_kappa {
         report.kappa = "recorded channel".into();
     } else {
         report.kappa = "missing".into();
@@ -862,6 +920,42 @@ pub fn from_raw(raw: RawTable, format: Format, file: &str, opts: &LoadOptions) -
             )
         })
         .collect();
+    // A channel bad on more than `sanity::REJECT_SHARE` of the rows is
+    // broken: it is rejected, the rows stay (κ counts only rows that move:
+    // standing rows have no slip ratio and are dropped as before).
+    let mut checks = checks;
+    for &(k, lo, hi) in checks.clone().iter() {
+        let c = SAMPLE_CHANNELS[k];
+        if !sanity::REJECTABLE.contains(&c) {
+            continue;
+        }
+        let rows = samples
+            .iter()
+            .filter(|s| c != "kappa" || (s.vx.is_finite() && s.vx.abs() > 1.0));
+        let (mut total, mut nan, mut out) = (0usize, 0usize, 0usize);
+        for s in rows {
+            let x = s.values()[k];
+            total += 1;
+            nan += usize::from(!x.is_finite());
+            out += usize::from(x.is_finite() && (x < lo || x > hi));
+        }
+        if total > 0 && (nan + out) as f64 > sanity::REJECT_SHARE * total as f64 {
+            let why = if out >= nan {
+                format!(
+                    "{:.1} % of its values outside [{lo}, {hi}] (ISO-W SI)",
+                    100.0 * out as f64 / total as f64
+                )
+            } else {
+                format!(
+                    "{:.1} % of its values NaN or infinite",
+                    100.0 * nan as f64 / total as f64
+                )
+            };
+            sanity::reject(&mut samples, &mut channels, &mut report, c, why);
+            report.missing.push(c.to_string());
+            checks.retain(|x| x.0 != k);
+        }
+    }
     let mut counts = vec![0usize; SAMPLE_CHANNELS.len() * 2];
     let mut keep = vec![true; n];
     for (i, s) in samples.iter().enumerate() {

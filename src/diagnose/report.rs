@@ -525,6 +525,18 @@ pub fn diagnose_with(
         .into_iter()
         .filter(|c| channel_present(rec, c))
         .collect();
+    // Guard: an empty analysis must not read as "Nothing is missing".
+    if channels.is_empty() || rec.segments.is_empty() {
+        return Err(crate::Error::Input(format!(
+            "diagnose: {}: {} — the recording cannot be analysed",
+            rec.source,
+            if channels.is_empty() {
+                "no usable Fx, Fy or Mz channel"
+            } else {
+                "no test segments (no load/slip programme recognised)"
+            }
+        )));
+    }
     step("locate + candidates");
     let owned = all();
     let cands: Vec<&dyn Candidate> = owned.iter().map(|c| c.as_ref()).collect();

@@ -32,6 +32,11 @@ pub struct MfFitOptions {
     pub holdout: Holdout,
     /// Take FNOMIN, NOMPRES (and INFLPRES), LONGVL from the data.
     pub nominal_from_data: bool,
+    /// Fit the radii and vertical stiffness keys to the recorded Re and Rl
+    /// before the force stages ([`super::geometry`]; R0 enters the Mz, Mx,
+    /// My equations). Off by default (the diagnosis baseline holds Re terms
+    /// for its rolling-radius candidate); `tyrekit fit` turns it on.
+    pub geometry: bool,
     pub threads: usize,
     pub fit: FitOptions,
     /// Minimum samples for a stage to run.
@@ -45,6 +50,7 @@ impl Default for MfFitOptions {
             transient: false,
             holdout: Holdout::None,
             nominal_from_data: true,
+            geometry: false,
             threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
             fit: FitOptions {
                 coarse_first: true,
@@ -66,6 +72,8 @@ pub struct MfFit {
     pub skipped: Vec<String>,
     /// Per recording: the (train, held-out) sample ranges.
     pub splits: Vec<TrainTest>,
+    /// The geometry fit, when [`MfFitOptions::geometry`] asked for it.
+    pub geometry: Option<super::geometry::Geometry>,
 }
 
 fn median(mut v: Vec<f64>) -> Option<f64> {
@@ -203,6 +211,11 @@ pub fn fit_mf(
         nominal_from_data(&mut tyre, recs)?;
     }
     widen_ranges(&mut tyre, recs)?;
+    let geometry = if opts.geometry {
+        Some(super::geometry::fit_geometry(&mut tyre, recs)?)
+    } else {
+        None
+    };
     let form = form_of(tyre.version);
     let splits: Vec<TrainTest> = recs
         .iter()
@@ -312,6 +325,7 @@ pub fn fit_mf(
         report,
         skipped,
         splits,
+        geometry,
     })
 }
 

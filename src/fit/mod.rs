@@ -35,6 +35,7 @@
 //! writes `fit.json`. Progress: pass `Some(&mut |p: &Progress| …)`.
 
 pub mod channels;
+pub mod geometry;
 pub mod grad_pure;
 pub mod holdout;
 pub mod identify;

@@ -49,6 +49,7 @@
 
 pub mod keys;
 pub mod parse;
+pub mod provenance;
 pub mod read;
 pub mod units;
 pub mod version;

@@ -1,0 +1,386 @@
+//! sanity — plausibility checks on a recording's recorded and derived
+//! channels, and the recognition of sign and unit slips.
+//!
+//! Two kinds of finding:
+//! - **A broken channel** (a dead or absurd wheel speed, an effective radius
+//!   outside a physical range of the loaded radius, a slip ratio pinned at −1
+//!   while the tyre carries lateral force, a moment channel mostly out of
+//!   range or saturated) is *rejected*: its values become NaN, it leaves the
+//!   recording's channel list, and a warning naming it goes into
+//!   [`LoadReport::rejected`]. The rows stay.
+//! - **A convention slip** (SAE signs read as ISO-W, a slip angle in degrees
+//!   in a column labelled radians, …) cannot be repaired by dropping anything:
+//!   loading stops with an error naming the likely cause and the flag or label
+//!   that fixes it.
+//!
+//! Must never: drop rows for a broken channel, reject a channel on a handful
+//! of bad values (those rows are dropped and counted by the loader as
+//! before), or let a sign or unit slip through silently.
+
+use super::{LoadReport, Sample};
+use crate::error::{Error, Result};
+
+/// Plausible radius (m) implied by a wheel speed, V/Ω, and range of a
+/// recorded radius: from a 10-inch kart wheel to an earth-mover tyre.
+pub const RADIUS_RANGE: (f64, f64) = (0.05, 5.0);
+
+/// A recorded effective rolling radius must lie within this factor range of
+/// the loaded radius (Re sits between Rl and R0: a few % above Rl for car
+/// and FSAE tyres, Pacejka 3rd ed. §9.2.1; ±30 % leaves room for any real
+/// tyre and catches V/Ω of a dead wheel speed, which is off by orders).
+pub const RE_OVER_RL: (f64, f64) = (0.7, 1.3);
+
+/// Share of a channel's values that must be bad (NaN, out of range,
+/// saturated) before the channel is rejected instead of its rows dropped.
+/// 20 %: a sensor that fails on a fifth of a test is broken, while short
+/// drop-outs (a few %) still cost only their rows.
+pub const REJECT_SHARE: f64 = 0.2;
+
+/// Sample channels that may be rejected (the rest are the inputs a row cannot
+/// be used without: time, speed, load, slip angle, inclination, pressure).
+pub const REJECTABLE: [&str; 7] = ["omega", "kappa", "Fx", "Fy", "Mx", "My", "Mz"];
+
+/// A row carries load when Fz exceeds this share of the recording's largest
+/// |Fz| (lead-ins and lifted rows are left out of the sign and slip tests).
+const LOADED_SHARE: f64 = 0.1;
+
+fn set_channel(samples: &mut [Sample], name: &str, v: f64) {
+    for s in samples.iter_mut() {
+        match name {
+            "omega" => s.omega = v,
+            "kappa" => s.kappa = v,
+            "Fx" => s.fx = v,
+            "Fy" => s.fy = v,
+            "Mx" => s.mx = v,
+            "My" => s.my = v,
+            "Mz" => s.mz = v,
+            _ => {}
+        }
+    }
+}
+
+/// Reject sample channel `name`: NaN everywhere, out of `channels`, warning.
+pub(crate) fn reject(
+    samples: &mut [Sample],
+    channels: &mut Vec<String>,
+    report: &mut LoadReport,
+    name: &str,
+    why: String,
+) {
+    set_channel(samples, name, f64::NAN);
+    channels.retain(|c| c != name);
+    report
+        .rejected
+        .push(format!("channel '{name}' rejected: {why}; rows kept"));
+}
+
+fn max_abs_fz(samples: &[Sample]) -> f64 {
+    samples
+        .iter()
+        .map(|s| s.fz.abs())
+        .filter(|f| f.is_finite())
+        .fold(0.0, f64::max)
+}
+
+fn loaded(s: &Sample, fmax: f64) -> bool {
+    s.fz.is_finite() && s.fz.abs() > LOADED_SHARE * fmax
+}
+
+fn median(mut v: Vec<f64>) -> Option<f64> {
+    v.retain(|x| x.is_finite());
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    Some(v[v.len() / 2])
+}
+
+/// Wheel speed: on rows rolling faster than 1 m/s the implied radius V/Ω
+/// must lie in [`RADIUS_RANGE`]. A channel failing on most of them (a dead
+/// N ≈ 0 rpm export, a wrong unit) is rejected.
+pub(crate) fn check_wheel_speed(
+    samples: &mut [Sample],
+    channels: &mut Vec<String>,
+    report: &mut LoadReport,
+) {
+    if !channels.iter().any(|c| c == "omega") {
+        return;
+    }
+    let (mut moving, mut bad) = (0usize, 0usize);
+    for s in samples
+        .iter()
+        .filter(|s| s.vx.is_finite() && s.vx.abs() > 1.0)
+    {
+        moving += 1;
+        let r = s.vx.abs() / s.omega;
+        if !(r.is_finite() && (RADIUS_RANGE.0..=RADIUS_RANGE.1).contains(&r)) {
+            bad += 1;
+        }
+    }
+    // Half the moving rows: a locked wheel (Ω = 0 at κ = −1) is real on a
+    // few rows of a brake sweep, never on most of a test.
+    if moving > 0 && bad * 2 > moving {
+        let med = median(samples.iter().map(|s| s.omega).collect()).unwrap_or(f64::NAN);
+        reject(
+            samples,
+            channels,
+            report,
+            "omega",
+            format!(
+                "wheel speed implies a radius V/Ω outside [{}, {}] m on {:.1} % of the rows rolling faster than 1 m/s (median Ω {med:.3} rad/s): dead or absurd wheel speed; κ cannot be computed from it",
+                RADIUS_RANGE.0,
+                RADIUS_RANGE.1,
+                100.0 * bad as f64 / moving as f64
+            ),
+        );
+    }
+}
+
+/// Recorded radii (extra channels `Rl`, `Re`): values outside
+/// [`RADIUS_RANGE`] (and Re outside [`RE_OVER_RL`] of Rl where both exist)
+/// become NaN; a radius channel failing on most loaded rows is removed.
+pub(crate) fn check_radii(
+    samples: &[Sample],
+    extra: &mut Vec<(String, Vec<f64>)>,
+    report: &mut LoadReport,
+) {
+    let fmax = max_abs_fz(samples);
+    let rl: Option<Vec<f64>> = extra
+        .iter()
+        .find(|(n, _)| n == "Rl")
+        .map(|(_, v)| v.clone());
+    let mut remove = Vec::new();
+    for (name, v) in extra.iter_mut() {
+        if name != "Rl" && name != "Re" {
+            continue;
+        }
+        let (mut n_loaded, mut bad) = (0usize, 0usize);
+        for (i, x) in v.iter_mut().enumerate() {
+            let mut ok = x.is_finite() && (RADIUS_RANGE.0..=RADIUS_RANGE.1).contains(x);
+            if name == "Re" {
+                if let Some(l) = rl.as_ref().map(|r| r[i]).filter(|l| l.is_finite()) {
+                    ok &= (RE_OVER_RL.0 * l..=RE_OVER_RL.1 * l).contains(x);
+                }
+            }
+            if samples.get(i).is_some_and(|s| loaded(s, fmax)) {
+                n_loaded += 1;
+                bad += usize::from(!ok);
+            }
+            if !ok {
+                *x = f64::NAN;
+            }
+        }
+        if n_loaded > 0 && bad * 2 > n_loaded {
+            remove.push(name.clone());
+            let range = if name == "Re" && rl.is_some() {
+                format!("[{}, {}]·Rl", RE_OVER_RL.0, RE_OVER_RL.1)
+            } else {
+                format!("[{}, {}] m", RADIUS_RANGE.0, RADIUS_RANGE.1)
+            };
+            report.rejected.push(format!(
+                "channel '{name}' rejected: outside {range} on {:.1} % of the loaded rows (a radius from a dead wheel speed?); rows kept",
+                100.0 * bad as f64 / n_loaded as f64
+            ));
+        }
+    }
+    extra.retain(|(n, _)| !remove.contains(n));
+    report.extra_units.retain(|(n, _)| !remove.contains(n));
+}
+
+/// Slip ratios pinned at −1 while the tyre carries lateral force (|Fy| >
+/// 10 % Fz: it is rolling and cornering, so it cannot be locked): a
+/// recorded κ (sample channel) or TTC's SR/SL extras computed from a dead
+/// wheel speed. Rejected when the median over such rows is below −0.9.
+pub(crate) fn check_pinned_slip(
+    samples: &mut [Sample],
+    channels: &mut Vec<String>,
+    extra: &mut Vec<(String, Vec<f64>)>,
+    report: &mut LoadReport,
+) {
+    let cornering: Vec<usize> = (0..samples.len())
+        .filter(|&i| {
+            let s = &samples[i];
+            s.fy.is_finite() && s.fz.is_finite() && s.fz > 0.0 && s.fy.abs() > 0.1 * s.fz
+        })
+        .collect();
+    if cornering.len() < 20 {
+        return;
+    }
+    let pinned = |v: &dyn Fn(usize) -> f64| {
+        median(cornering.iter().map(|&i| v(i)).collect()).is_some_and(|m| m < -0.9)
+    };
+    if channels.iter().any(|c| c == "kappa") && pinned(&|i| samples[i].kappa) {
+        reject(
+            samples,
+            channels,
+            report,
+            "kappa",
+            "the recorded slip ratio is pinned near −1 while the tyre carries lateral force (median < −0.9): it was computed from a dead wheel speed".into(),
+        );
+    }
+    let mut remove = Vec::new();
+    for (name, v) in extra.iter() {
+        let n = name.to_ascii_lowercase();
+        if (n == "sr" || n == "sl") && pinned(&|i| v[i]) {
+            remove.push(name.clone());
+            report.rejected.push(format!(
+                "channel '{name}' rejected: pinned near −1 while the tyre carries lateral force (median < −0.9): computed from a dead wheel speed; rows kept"
+            ));
+        }
+    }
+    extra.retain(|(n, _)| !remove.contains(n));
+    report.extra_units.retain(|(n, _)| !remove.contains(n));
+}
+
+/// Whether the recording rolls freely throughout: no Fx channel, or |Fx|
+/// below 10 % of Fz on 95 % of the loaded rows (a cornering-only test:
+/// rolling resistance and the induced drag of a cornering tyre stay well
+/// below that; a drive/brake sweep to κ = 0.1 passes it).
+pub(crate) fn free_rolling_run(samples: &[Sample], has_fx: bool) -> bool {
+    if !has_fx {
+        return true;
+    }
+    let fmax = max_abs_fz(samples);
+    let mut r: Vec<f64> = samples
+        .iter()
+        .filter(|s| loaded(s, fmax) && s.fx.is_finite())
+        .map(|s| (s.fx / s.fz).abs())
+        .collect();
+    if r.is_empty() {
+        return true;
+    }
+    r.sort_by(f64::total_cmp);
+    r[(r.len() * 95 / 100).min(r.len() - 1)] < 0.1
+}
+
+/// Sign and unit slips that make every later number wrong: stop with the
+/// likely cause and the fix. `axes` is the axis system the file was read
+/// in, `unit_of` the unit label a sample channel was given (None: none).
+pub(crate) fn check_conventions(
+    samples: &[Sample],
+    channels: &[String],
+    axes: super::conventions::AxisSystem,
+    unit_of: &dyn Fn(&str) -> Option<String>,
+    file: &str,
+) -> Result<()> {
+    use super::conventions::AxisSystem;
+    let err = |loc: &str, msg: String| Error::Recording {
+        file: file.to_string(),
+        location: format!("channel '{loc}'"),
+        message: msg,
+    };
+    let has = |c: &str| channels.iter().any(|x| x == c);
+    let label = |c: &str| unit_of(c).map_or("no unit".to_string(), |u| format!("unit '{u}'"));
+    // Angles: a degree column labelled (or defaulted to) radians shows values
+    // far beyond any physical slip angle (|α| ≤ π/2) or inclination (0.6 rad).
+    for (c, lim, what, eg) in [
+        ("alpha", std::f64::consts::FRAC_PI_2, "π/2", "SA [deg]"),
+        ("gamma", 0.6, "0.6 rad (34°)", "IA [deg]"),
+    ] {
+        // Only a column read as radians (labelled so, or without a unit); a
+        // value beyond the limit in a degree column is an out-of-range row.
+        let as_rad = unit_of(c).is_none_or(|u| {
+            matches!(
+                u.trim().to_ascii_lowercase().as_str(),
+                "rad" | "radian" | "radians"
+            )
+        });
+        if !has(c) || !as_rad {
+            continue;
+        }
+        let vals: Vec<f64> = samples
+            .iter()
+            .map(|s| s.get(c))
+            .filter(|v| v.is_finite())
+            .collect();
+        let over = vals.iter().filter(|v| v.abs() > lim).count();
+        if !vals.is_empty() && over as f64 > 0.05 * vals.len() as f64 {
+            let max = vals.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            return Err(err(
+                c,
+                format!(
+                    "{:.1} % of the values exceed {what} (largest {max:.3} after conversion, {}): the column is most likely in degrees but read as radians; give its unit in the header (e.g. '{eg}'), or in a TTC/TYDEX file fix the units row",
+                    100.0 * over as f64 / vals.len() as f64,
+                    label(c)
+                ),
+            ));
+        }
+    }
+    // Pressure: a gauge pressure in Pa below 1000 is no tyre's; kPa or bar
+    // labelled Pa.
+    if has("P") {
+        if let Some(m) = median(samples.iter().map(|s| s.p).collect()) {
+            if m > 0.0 && m < 1000.0 {
+                let likely = if m < 20.0 { "bar" } else { "kPa or psi" };
+                return Err(err(
+                    "P",
+                    format!(
+                        "median pressure {m:.3} Pa ({}) is no tyre's inflation pressure: the column is most likely in {likely}; give its unit in the header (e.g. 'P [kPa]')",
+                        label("P")
+                    ),
+                ));
+            }
+        }
+    }
+    // Signs. Fz > 0 when loaded in ISO-W.
+    let fmax = max_abs_fz(samples);
+    let loaded_rows: Vec<&Sample> = samples.iter().filter(|s| loaded(s, fmax)).collect();
+    let neg = loaded_rows.iter().filter(|s| s.fz < 0.0).count();
+    if !loaded_rows.is_empty() && neg * 2 > loaded_rows.len() {
+        let (cause, fix) = match axes {
+            AxisSystem::Sae => (
+                "the file's Fz is positive when loaded, so its signs are ISO-W/TYDEX, not SAE",
+                "--axes iso-w",
+            ),
+            _ => (
+                "the file's Fz is negative when loaded, as in SAE (TTC) axes, but it was read as ISO-W",
+                "--axes sae",
+            ),
+        };
+        return Err(err(
+            "Fz",
+            format!(
+                "{:.0} % of the loaded rows have Fz < 0 after conversion from {} to ISO-W (where a loaded tyre has Fz > 0): {cause}; read it with {fix}",
+                100.0 * neg as f64 / loaded_rows.len() as f64,
+                axes.name()
+            ),
+        ));
+    }
+    // Fy–α: in ISO-W (and SAE) Fy falls with α near zero slip (Kyα < 0 in
+    // ISO-W: Pacejka 3rd ed. §4.3, e.g. PKY1 < 0); a rising Fy means α's sign
+    // is reversed (adapted ISO).
+    if has("Fy") && has("alpha") {
+        let lim = 2f64.to_radians();
+        let (x, y): (Vec<f64>, Vec<f64>) = loaded_rows
+            .iter()
+            .filter(|s| {
+                s.alpha.abs() < lim && s.fy.is_finite() && s.alpha.is_finite() && s.fz > 0.0
+            })
+            .map(|s| (s.alpha, s.fy / s.fz))
+            .unzip();
+        let (lo, hi) = x.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, v| {
+            (a.0.min(*v), a.1.max(*v))
+        });
+        if x.len() >= 50 && hi - lo > 1f64.to_radians() {
+            if let Some((_, b)) = super::slip::fit_line(&x, &y) {
+                // b is Fy/Fz per rad; a real tyre's |Kyα|/Fz is 5–40 /rad.
+                // Demand a clear positive slope (> 1 /rad) so that noise on a
+                // camber-only or nearly flat run cannot trip it.
+                if b > 1.0 {
+                    let fix = match axes {
+                        AxisSystem::AdaptedIso => "--axes iso-w",
+                        _ => "--axes adapted-iso",
+                    };
+                    return Err(err(
+                        "Fy",
+                        format!(
+                            "Fy rises with the slip angle near α = 0 (slope {b:+.2} Fz/rad after conversion from {} to ISO-W, where it falls): the slip angle's sign is reversed relative to the force's; read it with {fix}",
+                            axes.name()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,214 @@
+//! Real-recording sanity checks: a TTC cornering export whose wheel-speed
+//! channel is dead (N ≈ 0 rpm, so the recorded RE = V/N is ±3.7e5 cm and SR ≈
+//! −1, as some real FSAE TTC cornering exports are), built in the TTC channel
+//! layout by the rig simulator and written as `.dat` and `.mat`, SI and US
+//! units; a broken moment channel; the same faults in TYDEX. The broken
+//! channel must be rejected by name, the rows kept, κ taken as free rolling
+//! and every sweep found as pure lateral (not `combined`).
+
+use std::path::PathBuf;
+use tyrekit::data::{load, LoadOptions, Loaded, Recording, SegmentKind};
+use tyrekit::mf::Tyre;
+use tyrekit::rig::{simulate, RigConfig, RigRun, SteadyMf, TtcUnits};
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("tyrekit-data-sanity-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+/// A cornering-only TTC programme (no drive/brake runs): three loads, two
+/// inclinations, one pressure, no warm-up (kept short).
+fn cornering_run(units: TtcUnits) -> RigRun {
+    let tyre = Tyre::builtin();
+    let mut cfg = RigConfig::standard(&tyre, 7);
+    cfg.units = units;
+    let p = &mut cfg.programme;
+    p.db_alphas.clear();
+    p.pressures = vec![p.pressures[1]];
+    p.inclinations = vec![0.0, 2f64.to_radians()];
+    p.loads = vec![4000.0, 2000.0, 6000.0];
+    p.warmup = None;
+    simulate(&cfg, &mut SteadyMf::new(tyre))
+}
+
+fn col<'a>(r: &'a mut RigRun, name: &str) -> &'a mut Vec<f64> {
+    &mut r
+        .table
+        .columns
+        .iter_mut()
+        .find(|c| c.name == name)
+        .unwrap_or_else(|| panic!("no column {name}"))
+        .data
+}
+
+/// N reads ≈ 0 rpm throughout; RE = V/N and SR follow from it as the
+/// export computes them.
+fn kill_wheel_speed(r: &mut RigRun) {
+    let n = col(r, "N");
+    for (i, x) in n.iter_mut().enumerate() {
+        *x = 1e-3 * ((i % 3) as f64 - 1.0);
+    }
+    for (i, x) in col(r, "RE").iter_mut().enumerate() {
+        *x = if i % 2 == 0 { 3.7e5 } else { -3.7e5 };
+    }
+    for x in col(r, "SR").iter_mut() {
+        *x = -1.0 + 1e-5;
+    }
+}
+
+fn read(p: &std::path::Path) -> Loaded {
+    load(p, &LoadOptions::default()).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+fn count(rec: &Recording, k: SegmentKind) -> usize {
+    rec.segments.iter().filter(|s| s.kind == k).count()
+}
+
+fn rejected(l: &Loaded, ch: &str) -> bool {
+    l.report
+        .rejected
+        .iter()
+        .any(|r| r.contains(&format!("'{ch}'")))
+}
+
+/// The dead-wheel-speed checks shared by every format.
+fn check_dead_wheel_speed(l: &Loaded, plan_lateral: usize, what: &str) {
+    let rec = &l.recording;
+    assert!(
+        rejected(l, "omega"),
+        "{what}: wheel speed not rejected: {:?}",
+        l.report.rejected
+    );
+    assert!(!rec.has("omega"), "{what}: omega still listed");
+    // Rows kept: nothing dropped for the dead channel (the rig's lead-in at
+    // zero speed is all the loader may cut, as the warm-up/lead-in).
+    assert_eq!(
+        l.report.dropped_total, 0,
+        "{what}: dropped {:?}",
+        l.report.dropped
+    );
+    // κ as free rolling, exactly 0 (the test rolls freely: it has no drive/brake runs).
+    assert!(
+        l.report.kappa.starts_with("κ = 0"),
+        "{what}: κ {}",
+        l.report.kappa
+    );
+    assert!(
+        rec.samples.iter().all(|s| s.kappa == 0.0),
+        "{what}: κ not 0"
+    );
+    // Segment kinds: every programmed sweep pure lateral, none combined.
+    assert_eq!(
+        count(rec, SegmentKind::Combined),
+        0,
+        "{what}: combined segments"
+    );
+    assert_eq!(
+        count(rec, SegmentKind::PureLateral),
+        plan_lateral,
+        "{what}: lateral segments {:?}",
+        rec.segments.iter().map(|s| s.kind).collect::<Vec<_>>()
+    );
+}
+
+#[test]
+fn ttc_dead_wheel_speed_dat_and_mat_si_and_us() {
+    for units in [TtcUnits::Si, TtcUnits::UsCustomary] {
+        let mut run = cornering_run(units);
+        let plan_lateral = run
+            .plan
+            .iter()
+            .filter(|s| s.kind == SegmentKind::PureLateral)
+            .count();
+        assert!(plan_lateral >= 6, "the programme has {plan_lateral} sweeps");
+        kill_wheel_speed(&mut run);
+        let dat = tmp(&format!("dead_{units:?}.dat"));
+        let mat = tmp(&format!("dead_{units:?}.mat"));
+        run.write_dat(&dat).unwrap();
+        run.write_mat(&mat, true).unwrap();
+        for p in [&dat, &mat] {
+            let l = read(p);
+            let what = format!("{} ({units:?})", p.display());
+            check_dead_wheel_speed(&l, plan_lateral, &what);
+            // The recorded RE (V/N of a dead N) and the pinned SR are rejected too.
+            assert!(
+                rejected(&l, "Re"),
+                "{what}: RE kept: {:?}",
+                l.report.rejected
+            );
+            assert!(l.recording.extra("Re").is_none(), "{what}: RE kept");
+            assert!(
+                rejected(&l, "SR"),
+                "{what}: SR kept: {:?}",
+                l.report.rejected
+            );
+            // The loaded radius is healthy and stays.
+            assert!(l.recording.extra("Rl").is_some(), "{what}: RL lost");
+        }
+    }
+}
+
+#[test]
+fn healthy_ttc_cornering_keeps_its_channels() {
+    // Control: the same export with a working wheel speed loses nothing.
+    let run = cornering_run(TtcUnits::Si);
+    let p = tmp("healthy.dat");
+    run.write_dat(&p).unwrap();
+    let l = read(&p);
+    assert!(l.report.rejected.is_empty(), "{:?}", l.report.rejected);
+    assert!(l.recording.has("omega") && l.recording.extra("Re").is_some());
+    // κ from wheel speed: small on a free-rolling cornering test (|κ| < 0.02:
+    // the rig's noise on Ω and V is 0.02 %, the free-rolling Re fit exact).
+    let worst = l
+        .recording
+        .samples
+        .iter()
+        .filter(|s| s.fz > 1000.0)
+        .fold(0.0f64, |m, s| m.max(s.kappa.abs()));
+    assert!(worst < 0.02, "largest |κ| {worst}");
+}
+
+#[test]
+fn absurd_moment_channel_loses_the_channel_not_the_rows() {
+    let mut run = cornering_run(TtcUnits::Si);
+    // Mx reads an absurd 9.9e5 N-m on 98 % of the rows (a saturated or
+    // mis-scaled channel).
+    let mx = col(&mut run, "MX");
+    let n = mx.len();
+    for (i, x) in mx.iter_mut().enumerate() {
+        if i % 50 != 0 {
+            *x = 9.9e5;
+        }
+    }
+    let p = tmp("absurd_mx.dat");
+    run.write_dat(&p).unwrap();
+    let l = read(&p);
+    assert!(rejected(&l, "Mx"), "{:?}", l.report.rejected);
+    assert!(!l.recording.has("Mx"));
+    assert_eq!(l.report.dropped_total, 0, "{:?}", l.report.dropped);
+    assert!(l.recording.samples.len() as f64 > 0.9 * n as f64);
+    assert!(l.recording.has("Fy") && l.recording.has("Mz"));
+    assert!(count(&l.recording, SegmentKind::PureLateral) >= 6);
+}
+
+#[test]
+fn tydex_dead_wheel_speed_and_pinned_slip() {
+    let run = cornering_run(TtcUnits::Si);
+    let p = tmp("healthy_for_tdx.dat");
+    run.write_dat(&p).unwrap();
+    let mut rec = read(&p).recording;
+    let plan_lateral = count(&rec, SegmentKind::PureLateral);
+    // A TYDEX file with a dead wheel speed and a recorded slip ratio pinned at −1.
+    for s in rec.samples.iter_mut() {
+        s.omega = 0.0;
+        s.kappa = -1.0;
+    }
+    rec.extra
+        .retain(|(n, _)| n != "Re" && n != "SR" && n != "SL");
+    let tdx = tmp("dead.tdx");
+    std::fs::write(&tdx, tyrekit::data::tdx::write(&rec)).unwrap();
+    let l = read(&tdx);
+    assert!(rejected(&l, "kappa"), "{:?}", l.report.rejected);
+    check_dead_wheel_speed(&l, plan_lateral, "TYDEX");
+}

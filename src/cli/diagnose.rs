@@ -11,11 +11,11 @@
 
 use crate::data::{load, LoadOptions, ReChoice};
 use crate::diagnose::baseline::{drop_unfitted, fit_baseline, HELD_PRESSURE_KEYS};
-use crate::diagnose::replay::ReplayOptions;
 use crate::diagnose::report::{diagnose_with, merge};
 use crate::diagnose::{html, plots};
 use crate::fit::Progress;
 use crate::mf::Tyre;
+use crate::residual::ReplayOptions;
 use crate::{Error, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -154,11 +154,11 @@ pub fn run(a: Args) -> Result<()> {
     if let Some(b) = &steps {
         b.finish_and_clear();
     }
-    let mut json = d.json.clone();
-    json["baseline"] = serde_json::json!(note);
-    json["plots"] = serde_json::to_value(&pl).unwrap_or_default();
+    let mut report = d.report.clone();
+    report.baseline = Some(note.clone());
+    report.plots = serde_json::to_value(&pl).ok();
     let jp = a.report.join("diagnosis.json");
-    let text = serde_json::to_string_pretty(&json)
+    let text = serde_json::to_string_pretty(&report)
         .map_err(|e| Error::Other(format!("diagnosis.json: {e}")))?;
     std::fs::write(&jp, text).map_err(|e| Error::io(&jp, e))?;
     let hp = a.report.join("report.html");
@@ -168,7 +168,7 @@ pub fn run(a: Args) -> Result<()> {
     for r in d.out_of_sample.iter().filter(|r| r.condition == "all") {
         println!(
             "  held out {}: σ {:.2} % -> {:.2} %, NRMSE {:.2} % -> {:.2} %",
-            crate::diagnose::report::pretty(r.channel),
+            r.channel.name(),
             100.0 * r.sigma_before,
             100.0 * r.sigma_after,
             100.0 * r.nrmse_before,

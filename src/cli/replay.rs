@@ -1,11 +1,11 @@
 //! `tyrekit replay` — step a recording's measured inputs through the tyre
 //! model the FMU runs and write measured and simulated forces side by side
-//! (see [`crate::diagnose::replay`] for the time base and the resets).
+//! (see [`crate::residual::replay`] for the time base and the resets).
 //!
 //! Must never: panic on a bad file or flag (errors name the file and flag).
 
-use crate::diagnose::replay::{replay, write_csv, ReplayOptions};
 use crate::mf::{Tyre, UseMode};
+use crate::residual::{replay, write_csv, ReplayOptions};
 use crate::transient::TransientKind;
 use crate::{Error, Result};
 use std::path::PathBuf;

@@ -20,8 +20,7 @@
 //!   equilibrium, not at an artificial zero deflection.
 //! * A sample whose core inputs (Vx, Fz, α) are missing or refused by the
 //!   model gets NaN outputs and ends its run (the next good sample starts a
-//!   new one). Missing κ, γ, φt read as 0, missing pressure as 0 (= the
-//!   .tir's INFLPRES), missing Ω as (1+κ)·Vx / R0.
+//!   new one). Missing optional inputs as in [`super::input`].
 //!
 //! Slips are prescribed ([`InputMode::Slips`]): rigs impose κ and α and
 //! record them; velocities would recompute κ through a model Re that the
@@ -30,12 +29,12 @@
 //! Must never: allocate per sample beyond the output vectors, or carry a
 //! state across a gap.
 
+use super::input::wheel_input;
 use crate::data::Recording;
 use crate::error::Result;
 use crate::mf::{Forces, Tyre, UseMode};
 use crate::transient::{
-    InputMode, TransientConfig, TransientKind, TransientModel, TransientOptions, WheelInput,
-    WheelOutput,
+    InputMode, TransientConfig, TransientKind, TransientModel, TransientOptions, WheelOutput,
 };
 use std::io::Write;
 
@@ -88,34 +87,6 @@ pub fn median_spacing(t: &[f64]) -> f64 {
     }
     let m = d.len() / 2;
     *d.select_nth_unstable_by(m, f64::total_cmp).1
-}
-
-/// The model's input for one recorded sample (None when a core input is missing).
-pub fn wheel_input(tyre: &Tyre, s: &crate::data::Sample) -> Option<WheelInput> {
-    if !(s.vx.is_finite() && s.fz.is_finite() && s.alpha.is_finite()) {
-        return None;
-    }
-    let or0 = |x: f64| if x.is_finite() { x } else { 0.0 };
-    let kappa = or0(s.kappa);
-    let omega = if s.omega.is_finite() {
-        s.omega
-    } else {
-        let r0 = tyre.params().p.unloaded_radius;
-        let r0 = if r0.is_finite() && r0 > 0.0 { r0 } else { 0.3 };
-        (1.0 + kappa) * s.vx / r0
-    };
-    Some(WheelInput {
-        vx: s.vx,
-        vy: 0.0,
-        omega,
-        fz: s.fz,
-        gamma: or0(s.gamma),
-        p: or0(s.p),
-        phit: or0(s.phit),
-        mu_scale: 0.0,
-        kappa_in: kappa,
-        alpha_in: s.alpha,
-    })
 }
 
 /// Replay `rec` through `tyre` (see the module docs for time base and resets).

@@ -21,8 +21,8 @@ pub struct Args {
     /// Output CSV: time,Fx,Fy,Mz,Fx_sim,Fy_sim,Mz_sim[,Mx,My,Mx_sim,My_sim] (ISO-W, SI).
     #[arg(long)]
     pub out: PathBuf,
-    /// Transient model: steady | relaxation | lugre.
-    #[arg(long, default_value = "steady")]
+    /// Transient model: file (as the tyre file's [TYREKIT] TRANSIENT says, steady when it says nothing) | steady | relaxation | lugre.
+    #[arg(long, default_value = "file")]
     pub transient: String,
     /// MFeval use mode (hundreds limits 1 on/2 off, tens α* 1 off/2 on, units turn slip).
     #[arg(long, default_value_t = 111)]
@@ -31,12 +31,6 @@ pub struct Args {
 
 /// Run the command.
 pub fn run(a: Args) -> Result<()> {
-    let kind = TransientKind::parse(&a.transient).ok_or_else(|| {
-        Error::Input(format!(
-            "--transient {}: expected steady, relaxation or lugre",
-            a.transient
-        ))
-    })?;
     let use_mode = UseMode::from_code(a.use_mode).ok_or_else(|| {
         Error::Input(format!(
             "--use-mode {}: expected three digits, each 1 or 2 (e.g. 111)",
@@ -44,21 +38,31 @@ pub fn run(a: Args) -> Result<()> {
         ))
     })?;
     let tyre = Tyre::from_file(&a.tir)?;
+    let kind = TransientKind::resolve(&a.transient, tyre.params())
+        .map_err(|e| Error::Input(format!("--transient: {e}")))?;
     let rec = crate::data::Recording::from_file(&a.recording)?;
+    // As the FMU runs by default: κ from the wheel speed where recorded.
     let opts = ReplayOptions {
         kind,
         use_mode,
+        wheel_speed: true,
         ..Default::default()
     };
+    let mode = crate::residual::input_mode(&rec, &opts);
     let rp = replay(&rec, &tyre, &opts)?;
     let f = std::fs::File::create(&a.out).map_err(|e| Error::io(&a.out, e))?;
     write_csv(&rec, &rp, f).map_err(|e| Error::io(&a.out, e))?;
     eprintln!(
-        "replayed {} samples ({} runs, {} skipped) with {} model -> {}",
+        "replayed {} samples ({} runs, {} skipped) with {} model, {} -> {}",
         rec.samples.len(),
         rp.runs.len(),
         rp.skipped,
         kind.name(),
+        match mode {
+            crate::transient::InputMode::Velocities =>
+                "κ from the wheel speed and the tyre's Re(Fz)",
+            crate::transient::InputMode::Slips => "slips as recorded (no wheel speed)",
+        },
         a.out.display()
     );
     Ok(())

@@ -4,7 +4,9 @@
 //!
 //! Missing optional inputs read as: κ, γ, φt → 0; pressure → 0 (= the
 //! `.tir`'s INFLPRES); Ω → (1 + κ)·Vx / R0 (the free-rolling wheel speed
-//! at the recorded slip with the unloaded radius).
+//! at the recorded slip with the unloaded radius). The lateral slip speed
+//! is Vy = tan α·|Vx| (ISO-W, Pacejka 3rd ed. eq. 2.12), so that the
+//! velocities input mode sees the recorded α exactly.
 //!
 //! Must never: invent a core input (Vx, Fz, α): a sample missing one has
 //! no model input (`None`).
@@ -57,7 +59,7 @@ pub fn wheel_input(tyre: &Tyre, s: &Sample) -> Option<WheelInput> {
     };
     Some(WheelInput {
         vx: s.vx,
-        vy: 0.0,
+        vy: s.alpha.tan() * s.vx.abs(),
         omega,
         fz: s.fz,
         gamma: m.gamma,

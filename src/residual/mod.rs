@@ -17,7 +17,7 @@ mod score;
 
 pub use channel::Channel;
 pub use input::{has_core_inputs, mf_input, wheel_input};
-pub use replay::{median_spacing, replay, write_csv, Replay, ReplayOptions};
+pub use replay::{input_mode, median_spacing, replay, write_csv, Replay, ReplayOptions};
 pub use score::{
     channel_nrmse, channel_sse, inverse_variances, nrmse_per_channel, offsets, sse, weighted_sse,
     PerChannel, FX, FY, MZ,

@@ -22,9 +22,13 @@
 //!   model gets NaN outputs and ends its run (the next good sample starts a
 //!   new one). Missing optional inputs as in [`super::input`].
 //!
-//! Slips are prescribed ([`InputMode::Slips`]): rigs impose κ and α and
-//! record them; velocities would recompute κ through a model Re that the
-//! rig's own Re definition need not share.
+//! By default slips are prescribed ([`InputMode::Slips`]): rigs impose κ
+//! and α and record them (the diagnosis scores its candidates so).
+//! With [`ReplayOptions::wheel_speed`] and a recording that has the wheel
+//! speed Ω, the model runs as the FMU is used by default
+//! ([`InputMode::Velocities`]): κ = (Ω·Re(Fz) − Vx)/|Vx| with the tyre's
+//! own effective rolling radius (so a rolling-radius finding changes the
+//! replay), α from Vy = tan α·|Vx|; without Ω the slips stay prescribed.
 //!
 //! Must never: allocate per sample beyond the output vectors, or carry a
 //! state across a gap.
@@ -48,6 +52,9 @@ pub struct ReplayOptions {
     pub gap_factor: f64,
     /// Duration (s) of the settling step after a reset (0: start at rest).
     pub settle_time: f64,
+    /// Take κ from the recorded wheel speed and the tyre's Re(Fz) (the
+    /// FMU's velocities input) when the recording has Ω (see the module docs).
+    pub wheel_speed: bool,
 }
 
 impl Default for ReplayOptions {
@@ -58,6 +65,7 @@ impl Default for ReplayOptions {
             options: TransientOptions::default(),
             gap_factor: 5.0,
             settle_time: 5.0,
+            wheel_speed: false,
         }
     }
 }
@@ -89,6 +97,15 @@ pub fn median_spacing(t: &[f64]) -> f64 {
     *d.select_nth_unstable_by(m, f64::total_cmp).1
 }
 
+/// The input mode a replay of `rec` runs with (see the module docs).
+pub fn input_mode(rec: &Recording, opts: &ReplayOptions) -> InputMode {
+    if opts.wheel_speed && rec.has("omega") {
+        InputMode::Velocities
+    } else {
+        InputMode::Slips
+    }
+}
+
 /// Replay `rec` through `tyre` (see the module docs for time base and resets).
 pub fn replay(rec: &Recording, tyre: &Tyre, opts: &ReplayOptions) -> Result<Replay> {
     let n = rec.samples.len();
@@ -102,7 +119,7 @@ pub fn replay(rec: &Recording, tyre: &Tyre, opts: &ReplayOptions) -> Result<Repl
     let mut model = TransientModel::with_options(
         TransientConfig {
             kind: opts.kind,
-            input_mode: InputMode::Slips,
+            input_mode: input_mode(rec, opts),
             use_mode: opts.use_mode,
         },
         opts.options,

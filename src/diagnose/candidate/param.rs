@@ -15,6 +15,7 @@ use crate::error::Result;
 use crate::mf::{Forces, MfInput, Tyre};
 use crate::residual::{mf_input, replay, Channel, ReplayOptions};
 use crate::tir::MfVersion;
+use crate::transient::extension::set_file_transient;
 use crate::transient::{LuGreParams, TransientKind};
 
 /// Most fit-half samples a static candidate is fitted on.
@@ -266,6 +267,11 @@ fn apply(base: &Tyre, spec: &Spec, theta: &[f64]) -> Result<Tyre> {
         for t in &q.targets {
             set(&mut p, *t, *v)?;
         }
+    }
+    // The file names the transient model it needs, so the FMU and `replay`
+    // run it by default.
+    if let Some(k) = spec.kind {
+        set_file_transient(&mut p, k);
     }
     Tyre::new(p)
 }

@@ -17,6 +17,7 @@ pub mod error;
 pub mod fit;
 pub mod fmi;
 pub mod mf;
+pub mod residual;
 pub mod rig;
 pub mod tir;
 pub mod transient;

@@ -8,6 +8,7 @@ use std::process::Command;
 use tyrekit::diagnose::locate::Finding;
 use tyrekit::diagnose::report::{caution, findings_in_words, QualityRow};
 use tyrekit::mf::Tyre;
+use tyrekit::residual::Channel;
 use tyrekit::rig::{effects, simulate, RigConfig};
 
 const NAMES: [&str; 9] = [
@@ -221,9 +222,9 @@ fn findings_in_words_names_the_signatures() {
     assert!(findings_in_words(&f[3..], "N").is_none());
 }
 
-fn row(channel: &'static str, before: f64, after: f64) -> QualityRow {
+fn row(channel: &str, before: f64, after: f64) -> QualityRow {
     QualityRow {
-        channel,
+        channel: Channel::parse(channel).expect("a channel name"),
         condition: "all".into(),
         n: 1000,
         sigma_before: before,

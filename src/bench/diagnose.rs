@@ -11,10 +11,10 @@
 
 use crate::diagnose::baseline::{drop_unfitted, fit_baseline};
 use crate::diagnose::locate::frictional_energy;
-use crate::diagnose::replay::{replay, ReplayOptions};
 use crate::diagnose::report::{diagnose, locate_channel};
 use crate::diagnose::{html, plots};
 use crate::mf::Tyre;
+use crate::residual::{replay, Channel, ReplayOptions};
 use crate::rig::{effects, simulate, RigConfig};
 use crate::transient::TransientKind;
 use std::time::Instant;
@@ -60,7 +60,7 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
     let base = replay(&rec, &tyre, &ReplayOptions::default())?;
     let t0 = Instant::now();
     let e = frictional_energy(&rec);
-    let f = locate_channel(&rec, &base.sim, &e, "FY");
+    let f = locate_channel(&rec, &base.sim, &e, Channel::Fy);
     println!(
         "[diagnose] locate FY (999 permutations) {:8.3} s  (top: {})",
         t0.elapsed().as_secs_f64(),

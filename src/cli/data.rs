@@ -62,14 +62,14 @@ impl RecordingArgs {
 
 /// Load every recording with `o`, printing each rejected channel as a
 /// warning on stderr (prefixed by the command's name).
-pub fn load_all(paths: &[PathBuf], o: &LoadOptions, cmd: &str) -> Result<Vec<data::Recording>> {
+pub fn load_all(paths: &[PathBuf], o: &LoadOptions, cmd: &str) -> Result<Vec<data::Loaded>> {
     let mut out = Vec::with_capacity(paths.len());
     for p in paths {
         let l = data::load(p, o)?;
         for r in &l.report.rejected {
             eprintln!("tyrekit {cmd}: warning: {}: {r}", p.display());
         }
-        out.push(l.recording);
+        out.push(l);
     }
     Ok(out)
 }

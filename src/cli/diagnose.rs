@@ -11,11 +11,11 @@
 
 use crate::data::ReChoice;
 use crate::diagnose::baseline::{drop_unfitted, fit_baseline, HELD_PRESSURE_KEYS};
-use crate::diagnose::replay::ReplayOptions;
 use crate::diagnose::report::{diagnose_with, merge};
 use crate::diagnose::{html, plots};
 use crate::fit::Progress;
 use crate::mf::Tyre;
+use crate::residual::ReplayOptions;
 use crate::{Error, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -72,7 +72,10 @@ pub fn run(a: Args) -> Result<()> {
             None => ReChoice::FreeRolling,
         };
     }
-    let mut recs = crate::cli::data::load_all(&a.recordings, &opts, "diagnose")?;
+    let mut recs: Vec<_> = crate::cli::data::load_all(&a.recordings, &opts, "diagnose")?
+        .into_iter()
+        .map(|l| l.recording)
+        .collect();
     let mut inputs = a.recordings.clone();
     inputs.extend(a.tir.iter().cloned());
     let mut prov = crate::tir::provenance::Provenance::of_inputs(&inputs)?;
@@ -156,11 +159,11 @@ pub fn run(a: Args) -> Result<()> {
     if let Some(b) = &steps {
         b.finish_and_clear();
     }
-    let mut json = d.json.clone();
-    json["baseline"] = serde_json::json!(note);
-    json["plots"] = serde_json::to_value(&pl).unwrap_or_default();
+    let mut report = d.report.clone();
+    report.baseline = Some(note.clone());
+    report.plots = serde_json::to_value(&pl).ok();
     let jp = a.report.join("diagnosis.json");
-    let text = serde_json::to_string_pretty(&json)
+    let text = serde_json::to_string_pretty(&report)
         .map_err(|e| Error::Other(format!("diagnosis.json: {e}")))?;
     std::fs::write(&jp, text).map_err(|e| Error::io(&jp, e))?;
     let hp = a.report.join("report.html");
@@ -170,7 +173,7 @@ pub fn run(a: Args) -> Result<()> {
     for r in d.out_of_sample.iter().filter(|r| r.condition == "all") {
         println!(
             "  held out {}: σ {:.2} % -> {:.2} %, NRMSE {:.2} % -> {:.2} %",
-            crate::diagnose::report::pretty(r.channel),
+            r.channel.name(),
             100.0 * r.sigma_before,
             100.0 * r.sigma_after,
             100.0 * r.nrmse_before,

@@ -38,7 +38,8 @@ pub struct Args {
     /// only when named).
     #[arg(long, value_delimiter = ',')]
     pub only: Vec<String>,
-    /// Hold data out of the fit: none, run[:K], condition[:K].
+    /// Hold data out of the fit: none, run[:K], condition[:K], tail:F (the last
+    /// fraction F of each recording's time, e.g. tail:0.3).
     #[arg(long, default_value = "none")]
     pub holdout: String,
     /// Directory for fit.json and the SVG plots.
@@ -102,7 +103,13 @@ pub fn run(args: Args) -> Result<()> {
         .then(|| Tyre::new(start.clone()))
         .transpose()?;
     let load = args.read.options(start_tyre.as_ref(), "--start")?;
-    let recs: Vec<Recording> = crate::cli::data::load_all(&args.recordings, &load, "fit")?;
+    let loaded = crate::cli::data::load_all(&args.recordings, &load, "fit")?;
+    // Time origin of each recording before its warm-up cut (for --holdout tail).
+    opts.t_origins = loaded
+        .iter()
+        .map(|l| l.report.warmup.as_ref().map(|w| w.t_start))
+        .collect();
+    let recs: Vec<Recording> = loaded.into_iter().map(|l| l.recording).collect();
 
     let bar = std::io::stderr().is_terminal().then(|| {
         let b = indicatif::ProgressBar::new(100);

@@ -1,11 +1,11 @@
 //! `tyrekit replay` — step a recording's measured inputs through the tyre
 //! model the FMU runs and write measured and simulated forces side by side
-//! (see [`crate::diagnose::replay`] for the time base and the resets).
+//! (see [`crate::residual::replay`] for the time base and the resets).
 //!
 //! Must never: panic on a bad file or flag (errors name the file and flag).
 
-use crate::diagnose::replay::{replay, write_csv, ReplayOptions};
 use crate::mf::{Tyre, UseMode};
+use crate::residual::{replay, write_csv, ReplayOptions};
 use crate::transient::TransientKind;
 use crate::{Error, Result};
 use std::path::PathBuf;
@@ -21,8 +21,8 @@ pub struct Args {
     /// Output CSV: time,Fx,Fy,Mz,Fx_sim,Fy_sim,Mz_sim[,Mx,My,Mx_sim,My_sim] (ISO-W, SI).
     #[arg(long)]
     pub out: PathBuf,
-    /// Transient model: steady | relaxation | lugre.
-    #[arg(long, default_value = "steady")]
+    /// Transient model: file (as the tyre file's [TYREKIT] TRANSIENT says, steady when it says nothing) | steady | relaxation | lugre.
+    #[arg(long, default_value = "file")]
     pub transient: String,
     /// MFeval use mode (hundreds limits 1 on/2 off, tens α* 1 off/2 on, units turn slip).
     #[arg(long, default_value_t = 111)]
@@ -34,12 +34,6 @@ pub struct Args {
 
 /// Run the command.
 pub fn run(a: Args) -> Result<()> {
-    let kind = TransientKind::parse(&a.transient).ok_or_else(|| {
-        Error::Input(format!(
-            "--transient {}: expected steady, relaxation or lugre",
-            a.transient
-        ))
-    })?;
     let use_mode = UseMode::from_code(a.use_mode).ok_or_else(|| {
         Error::Input(format!(
             "--use-mode {}: expected three digits, each 1 or 2 (e.g. 111)",
@@ -47,23 +41,34 @@ pub fn run(a: Args) -> Result<()> {
         ))
     })?;
     let tyre = Tyre::from_file(&a.tir)?;
+    let kind = TransientKind::resolve(&a.transient, tyre.params())
+        .map_err(|e| Error::Input(format!("--transient: {e}")))?;
     let load = a.read.options(Some(&tyre), "--tir")?;
-    let rec =
-        crate::cli::data::load_all(std::slice::from_ref(&a.recording), &load, "replay")?.remove(0);
+    let rec = crate::cli::data::load_all(std::slice::from_ref(&a.recording), &load, "replay")?
+        .remove(0)
+        .recording;
+    // As the FMU runs by default: κ from the wheel speed where recorded.
     let opts = ReplayOptions {
         kind,
         use_mode,
+        wheel_speed: true,
         ..Default::default()
     };
+    let mode = crate::residual::input_mode(&rec, &opts);
     let rp = replay(&rec, &tyre, &opts)?;
     let f = std::fs::File::create(&a.out).map_err(|e| Error::io(&a.out, e))?;
     write_csv(&rec, &rp, f).map_err(|e| Error::io(&a.out, e))?;
     eprintln!(
-        "replayed {} samples ({} runs, {} skipped) with {} model -> {}",
+        "replayed {} samples ({} runs, {} skipped) with {} model, {} -> {}",
         rec.samples.len(),
         rp.runs.len(),
         rp.skipped,
         kind.name(),
+        match mode {
+            crate::transient::InputMode::Velocities =>
+                "κ from the wheel speed and the tyre's Re(Fz)",
+            crate::transient::InputMode::Slips => "slips as recorded (no wheel speed)",
+        },
         a.out.display()
     );
     Ok(())

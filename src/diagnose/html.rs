@@ -9,7 +9,7 @@
 //! from a recording (file names, sources) through unescaped.
 
 use super::plots::Plot;
-use super::report::{pretty, Diagnosis, QualityRow};
+use super::report::{Diagnosis, NrmseMap, QualityRow};
 use serde_json::Value;
 use std::fmt::Write;
 
@@ -57,7 +57,7 @@ fn quality_table(rows: &[QualityRow]) -> String {
             s,
             "<tr{}><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td class=\"{}\">{}</td><td>{}</td><td>{}</td></tr>",
             if r.condition == "all" { " class=\"all\"" } else { "" },
-            pretty(r.channel),
+            r.channel.name(),
             esc(&r.condition),
             r.n,
             pct(r.sigma_before),
@@ -94,35 +94,34 @@ figcaption{{font-size:.9em;color:#444}} details{{margin:1em 0}}\
     );
     // Candidates.
     s.push_str("<h2>Candidates, ranked (verdict first)</h2>\n<table><tr><th>effect</th><th>held-out gain %</th><th>ΔBIC</th><th>parameters</th><th>NRMSE before (FX/FY/MZ) %</th><th>NRMSE after %</th><th>held-out NRMSE before → after (FY) %</th></tr>\n");
-    let three = |v: &Value| {
+    let three = |v: &NrmseMap| {
         ["FX", "FY", "MZ"]
             .iter()
-            .map(|k| v[k].as_f64().map_or("–".into(), pct))
+            .map(|k| v.get(k).copied().flatten().map_or("–".into(), pct))
             .collect::<Vec<_>>()
             .join(" / ")
     };
-    if let Some(effects) = d.json["effects"].as_array() {
-        for e in effects {
-            let params = e["parameters"].as_object().map_or(String::new(), |m| {
-                m.iter()
-                    .map(|(k, v)| format!("{} = {}", esc(k), num(v)))
-                    .collect::<Vec<_>>()
-                    .join("<br>")
-            });
-            let _ = writeln!(
-                s,
-                "<tr{}><td>{}</td><td>{}</td><td>{:+.1}</td><td>{}</td><td>{}</td><td>{}</td><td>{} → {}</td></tr>",
-                if e["name"] == d.json["verdict"] { " class=\"all\"" } else { "" },
-                esc(e["name"].as_str().unwrap_or("?")),
-                e["score"].as_f64().map_or("–".into(), pct),
-                e["delta_bic"].as_f64().unwrap_or(f64::NAN),
-                params,
-                three(&e["nrmse_before"]),
-                three(&e["nrmse_after"]),
-                e["nrmse_before_held_out"]["FY"].as_f64().map_or("–".into(), pct),
-                e["nrmse_after_held_out"]["FY"].as_f64().map_or("–".into(), pct),
-            );
-        }
+    let fy = |v: &NrmseMap| v.get("FY").copied().flatten().map_or("–".into(), pct);
+    for e in &d.report.effects {
+        let params = e
+            .parameters
+            .iter()
+            .map(|(k, v)| format!("{} = {}", esc(k), num(&Value::from(*v))))
+            .collect::<Vec<_>>()
+            .join("<br>");
+        let _ = writeln!(
+            s,
+            "<tr{}><td>{}</td><td>{}</td><td>{:+.1}</td><td>{}</td><td>{}</td><td>{}</td><td>{} → {}</td></tr>",
+            if e.name == d.report.verdict { " class=\"all\"" } else { "" },
+            esc(&e.name),
+            pct(e.score),
+            e.delta_bic,
+            params,
+            three(&e.nrmse_before),
+            three(&e.nrmse_after),
+            fy(&e.nrmse_before_held_out),
+            fy(&e.nrmse_after_held_out),
+        );
     }
     s.push_str("</table>\n<p><small>Held-out gain: share of the baseline's squared error (FX, FY, MZ, each over its variance) removed on the segments the candidate was not fitted on (the segments alternate between the halves within each group of kind and load); constant channel offsets are estimated on the fit half and removed. ΔBIC over the whole recording with an effective sample count of n/50 (rig channels are strongly autocorrelated): negative = the extra parameters pay for themselves.</small></p>\n");
     // Locate.
@@ -131,7 +130,7 @@ figcaption{{font-size:.9em;color:#444}} details{{margin:1em 0}}\
         let _ = writeln!(
             s,
             "<h3>{}</h3>\n<table><tr><th>grouping</th><th>statistic</th><th>z</th><th>p</th><th>p (Holm)</th><th>detail</th></tr>",
-            pretty(ch)
+            ch.name()
         );
         for x in f {
             let _ = writeln!(

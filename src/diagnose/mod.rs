@@ -1,5 +1,5 @@
-//! diagnose — why simulation and recording differ: replay a recording's
-//! measured inputs through the tyre model the FMU runs ([`replay`]), locate
+//! diagnose — why simulation and recording differ: with the residuals of
+//! the residual stage ([`crate::residual`]: replay, channels, scores), locate
 //! where the residuals concentrate with a statistic and a significance for
 //! each grouping ([`locate`]), fit the baseline when none is given
 //! ([`baseline`]), name, model and fit the physics left out ([`candidate`]),
@@ -15,5 +15,11 @@ pub mod candidate;
 pub mod html;
 pub mod locate;
 pub mod plots;
-pub mod replay;
+/// The residual stage's replay, kept at its former path for callers
+/// ([`crate::residual`] is its home).
+pub mod replay {
+    pub use crate::residual::{
+        median_spacing, replay, wheel_input, write_csv, Replay, ReplayOptions,
+    };
+}
 pub mod report;

@@ -17,9 +17,10 @@
 //! Must never: draw more than a few thousand points per series (strided),
 //! or fail on a channel the recording lacks (it is skipped).
 
-use super::report::{channel_present, channel_series, pretty, split, Diagnosis, REPORT_CHANNELS};
+use super::report::{channel_present, channel_series, split, Diagnosis};
 use crate::data::Recording;
 use crate::error::{Error, Result};
+use crate::residual::Channel;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -178,6 +179,8 @@ fn common_range(sets: &[&[(f64, f64)]]) -> (f64, f64) {
 
 /// Per-sample data of one channel for the plots.
 struct Chan<'a> {
+    ch: Channel,
+    /// The channel's report key ("FY"), as in `diagnosis.json`.
     name: &'static str,
     unit: &'static str,
     meas: Vec<f64>,
@@ -193,7 +196,7 @@ impl Chan<'_> {
         self.meas[i] - if after { self.ext[i] } else { self.base[i] }
     }
     fn slip_deg(&self, i: usize) -> f64 {
-        if self.name == "FX" {
+        if self.ch == Channel::Fx {
             self.slip[i]
         } else {
             self.slip[i].to_degrees()
@@ -215,20 +218,22 @@ impl Chan<'_> {
 /// Draw every picture of the diagnosis into `dir`.
 pub fn draw_all(rec: &Recording, d: &Diagnosis, dir: &Path) -> Result<Vec<Plot>> {
     let mut out = Vec::new();
-    for (name, unit) in REPORT_CHANNELS {
-        if !channel_present(rec, name) {
+    for ch in Channel::SCORED {
+        let (name, unit) = (ch.key(), ch.unit());
+        if !channel_present(rec, ch) {
             continue;
         }
-        let (meas, base, slip) = channel_series(rec, &d.baseline_sim, name);
-        let (_, ext, _) = channel_series(rec, &d.extended_sim, name);
+        let (meas, base, slip) = channel_series(rec, &d.baseline_sim, ch);
+        let (_, ext, _) = channel_series(rec, &d.extended_sim, ch);
         let c = Chan {
+            ch,
             name,
             unit,
             meas,
             base,
             ext,
             slip,
-            slip_label: if name == "FX" {
+            slip_label: if ch == Channel::Fx {
                 "kappa [-]"
             } else {
                 "alpha [deg]"
@@ -299,7 +304,7 @@ fn residual_slip(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
         panel(
             &a[0],
             &path,
-            &format!("{} residual vs slip: baseline", pretty(c.name)),
+            &format!("{} residual vs slip: baseline", c.ch.name()),
             c.slip_label,
             &yl,
             &sb,
@@ -308,11 +313,7 @@ fn residual_slip(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
         panel(
             &a[1],
             &path,
-            &format!(
-                "{} residual vs slip: {}",
-                pretty(c.name),
-                after_label(verdict)
-            ),
+            &format!("{} residual vs slip: {}", c.ch.name(), after_label(verdict)),
             c.slip_label,
             &yl,
             &sa,
@@ -324,7 +325,7 @@ fn residual_slip(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
         channel: c.name,
         caption: format!(
             "{} residual map against slip, coloured by load: structure (a slope at small slip = stiffness error, a bulge near the peak = friction error, a band that splits = hysteresis) should vanish from left to right.",
-            pretty(c.name)
+            c.ch.name()
         ),
     })
 }
@@ -375,7 +376,7 @@ fn residual_load(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
         panel(
             &ar[0],
             &path,
-            &format!("{} force scale error per segment vs load", pretty(c.name)),
+            &format!("{} force scale error per segment vs load", c.ch.name()),
             "Fz [N]",
             "Σ r·F / Σ F² [%]",
             &[
@@ -390,7 +391,7 @@ fn residual_load(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
         channel: c.name,
         caption: format!(
             "Per segment, the {} residual as a share of the model force (+ = measured stronger) against load: a trend with load is a load-sensitivity error, scatter between segments at one load a pressure, speed or temperature effect.",
-            pretty(c.name)
+            c.ch.name()
         ),
     })
 }
@@ -450,10 +451,7 @@ fn hysteresis(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
         panel(
             &a[0],
             &path,
-            &format!(
-                "{} residual, rising vs falling slip: baseline",
-                pretty(c.name)
-            ),
+            &format!("{} residual, rising vs falling slip: baseline", c.ch.name()),
             c.slip_label,
             &yl,
             &[
@@ -465,7 +463,7 @@ fn hysteresis(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
         panel(
             &a[1],
             &path,
-            &format!("{}: {}", pretty(c.name), after_label(verdict)),
+            &format!("{}: {}", c.ch.name(), after_label(verdict)),
             c.slip_label,
             &yl,
             &[
@@ -480,7 +478,7 @@ fn hysteresis(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
         channel: c.name,
         caption: format!(
             "Hysteresis: the {} residual averaged in {BINS} slip bins, rising sweeps against falling ones. Two curves apart = the measured force depends on where the slip came from (transient lag, bristle hysteresis); they should close on the right.",
-            pretty(c.name)
+            c.ch.name()
         ),
     })
 }
@@ -546,7 +544,7 @@ fn drift(c: &Chan, energy: &[f64], verdict: &str, dir: &Path) -> Result<Plot> {
         panel(
             &a[0],
             &path,
-            &format!("{} residual vs time in run", pretty(c.name)),
+            &format!("{} residual vs time in run", c.ch.name()),
             "time since the segment began [s]",
             &yl,
             &[
@@ -558,10 +556,7 @@ fn drift(c: &Chan, energy: &[f64], verdict: &str, dir: &Path) -> Result<Plot> {
         panel(
             &a[1],
             &path,
-            &format!(
-                "{} residual per segment vs frictional energy",
-                pretty(c.name)
-            ),
+            &format!("{} residual per segment vs frictional energy", c.ch.name()),
             "accumulated frictional energy [kJ]",
             &yl,
             &[
@@ -576,7 +571,7 @@ fn drift(c: &Chan, energy: &[f64], verdict: &str, dir: &Path) -> Result<Plot> {
         channel: c.name,
         caption: format!(
             "Drift: the signed {} residual (+ = measured stronger than the model) against time within a run and, per segment, against the frictional energy put into the tread since the start. A trend is a state that builds up (tread temperature, wear); it should flatten on the extended model.",
-            pretty(c.name)
+            c.ch.name()
         ),
     })
 }
@@ -649,7 +644,7 @@ fn overlay(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
                 &path,
                 &title,
                 c.slip_label,
-                &format!("{} [{}]", pretty(c.name), c.unit),
+                &format!("{} [{}]", c.ch.name(), c.unit),
                 &series,
                 None,
             )?;
@@ -661,7 +656,7 @@ fn overlay(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
         channel: c.name,
         caption: format!(
             "Measured (grey), baseline (blue) and extended model (red) {} on the held-out segments the verdict changes most (segments the candidates were not fitted on).",
-            pretty(c.name)
+            c.ch.name()
         ),
     })
 }

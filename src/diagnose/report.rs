@@ -28,80 +28,44 @@
 //! [`locate`] did not.
 
 use super::candidate::{
-    all, channels_in_words, evaluate, select, why_not, Candidate, Evaluation, CHANNELS,
+    all, channels_in_words, evaluate, select, why_not, Candidate, ChannelScore, Evaluation,
 };
 use super::locate::{frictional_energy, locate, Finding, LocateOptions, Residuals};
-use super::replay::{replay, ReplayOptions};
 use crate::data::Recording;
 use crate::error::Result;
 use crate::fit::metrics::{self, nrmse, sigma};
 use crate::mf::{Forces, Tyre};
-use serde_json::{json, Map, Value};
+use crate::residual::{nrmse_per_channel, replay, Channel, ReplayOptions};
+use serde::Serialize;
+use serde_json::Value;
+use std::collections::BTreeMap;
 use std::ops::Range;
 
 /// Smallest held-out gain that names an effect (the rule: [`super::candidate::select`]).
 pub use super::candidate::MIN_GAIN;
 
-/// The channels the report scores and plots: (name, unit).
-pub const REPORT_CHANNELS: [(&str, &str); 3] = [("FX", "N"), ("FY", "N"), ("MZ", "N m")];
-
-/// NRMSE per channel (FX, FY, MZ) of `sim` against the recording, over the
-/// samples where `mask` is true (`None`: all).
-pub fn nrmse_map(rec: &Recording, sim: &[Forces], mask: Option<&[bool]>) -> Value {
-    let mut m = Map::new();
-    for (name, fs, fm) in CHANNELS {
-        let on = |i: usize| mask.is_none_or(|k| k.get(i).copied().unwrap_or(false));
-        let (y, p): (Vec<f64>, Vec<f64>) = rec
-            .samples
-            .iter()
-            .zip(sim)
-            .enumerate()
-            .filter(|(i, _)| on(*i))
-            .map(|(_, (s, f))| (fm(s), fs(f)))
-            .unzip();
-        let v = nrmse(&p, &y);
-        m.insert(
-            name.into(),
-            if v.is_finite() { json!(v) } else { Value::Null },
-        );
-    }
-    Value::Object(m)
-}
+/// NRMSE per scored channel of `sim` against the recording over the
+/// samples where `mask` is true (`None`: all), keyed "FX", "FY", "MZ"
+/// (None where the channel has no data).
+pub type NrmseMap = BTreeMap<&'static str, Option<f64>>;
 
 /// (measured, simulated, driving slip) of one channel.
 pub fn channel_series(
     rec: &Recording,
     sim: &[Forces],
-    channel: &str,
+    channel: Channel,
 ) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let s = &rec.samples;
-    match channel {
-        "FX" => (
-            s.iter().map(|s| s.fx).collect(),
-            sim.iter().map(|f| f.fx).collect(),
-            s.iter().map(|s| s.kappa).collect(),
-        ),
-        "MZ" => (
-            s.iter().map(|s| s.mz).collect(),
-            sim.iter().map(|f| f.mz).collect(),
-            s.iter().map(|s| s.alpha).collect(),
-        ),
-        _ => (
-            s.iter().map(|s| s.fy).collect(),
-            sim.iter().map(|f| f.fy).collect(),
-            s.iter().map(|s| s.alpha).collect(),
-        ),
-    }
+    (
+        s.iter().map(|s| channel.measured(s)).collect(),
+        sim.iter().map(|f| channel.of_forces(f)).collect(),
+        s.iter().map(|s| channel.driving_slip(s)).collect(),
+    )
 }
 
-/// Whether the recording carries `channel` (FX/FY/MZ) with some variation.
-pub fn channel_present(rec: &Recording, channel: &str) -> bool {
-    let name = match channel {
-        "FX" => "Fx",
-        "MZ" => "Mz",
-        _ => "Fy",
-    };
-    rec.has(name)
+/// Whether the recording carries `channel`.
+pub fn channel_present(rec: &Recording, channel: Channel) -> bool {
+    rec.has(channel.name())
 }
 
 /// Locate findings of one channel.
@@ -109,7 +73,7 @@ pub fn locate_channel(
     rec: &Recording,
     sim: &[Forces],
     energy: &[f64],
-    channel: &str,
+    channel: Channel,
 ) -> Vec<Finding> {
     let (meas, simc, slip) = channel_series(rec, sim, channel);
     let r: Vec<f64> = meas.iter().zip(&simc).map(|(m, s)| m - s).collect();
@@ -152,7 +116,7 @@ fn ranges(mask: &[bool]) -> Vec<Range<usize>> {
 /// One row of the quality table.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct QualityRow {
-    pub channel: &'static str,
+    pub channel: Channel,
     /// "all", "Fz 4000 N, γ 0.0°, p 220 kPa" or "Vx 16.2 m/s".
     pub condition: String,
     pub n: usize,
@@ -192,15 +156,11 @@ pub fn quality(
     ranges: &[Range<usize>],
 ) -> Result<Vec<QualityRow>> {
     let mut rows = Vec::new();
-    for (ch, _) in REPORT_CHANNELS {
+    for ch in Channel::SCORED {
         if !channel_present(rec, ch) {
             continue;
         }
-        let name = match ch {
-            "FX" => "Fx",
-            "MZ" => "Mz",
-            _ => "Fy",
-        };
+        let name = ch.name();
         let (_, sb, _) = channel_series(rec, before, ch);
         let (y, sa, _) = channel_series(rec, after, ch);
         let (sb, sa) = (with_offset(&y, &sb, fit), with_offset(&y, &sa, fit));
@@ -357,19 +317,15 @@ fn set_point(grouping: &str, x: f64) -> String {
 
 /// The explanation of the verdict (see the module docs).
 pub fn explain(
-    findings: &[(&'static str, Vec<Finding>)],
+    findings: &[(Channel, Vec<Finding>)],
     verdict: Option<&Evaluation>,
     best_other: Option<&Evaluation>,
     alpha: f64,
 ) -> String {
     let mut where_ = Vec::new();
     for (ch, f) in findings {
-        let unit = REPORT_CHANNELS
-            .iter()
-            .find(|c| c.0 == *ch)
-            .map_or("", |c| c.1);
-        if let Some(w) = findings_in_words(f, unit) {
-            where_.push(format!("the {} residual {w}", pretty(ch)));
+        if let Some(w) = findings_in_words(f, ch.unit()) {
+            where_.push(format!("the {} residual {w}", ch.name()));
         }
     }
     let located = if where_.is_empty() {
@@ -446,7 +402,7 @@ pub fn caution(out_of_sample: &[QualityRow]) -> Option<String> {
         .map(|r| {
             format!(
                 "{} (held-out σ {:.2} % → {:.2} %)",
-                pretty(r.channel),
+                r.channel.name(),
                 100.0 * r.sigma_before,
                 100.0 * r.sigma_after
             )
@@ -458,7 +414,7 @@ pub fn caution(out_of_sample: &[QualityRow]) -> Option<String> {
     let better: Vec<&str> = all
         .iter()
         .filter(|r| r.sigma_after < r.sigma_before)
-        .map(|r| pretty(r.channel))
+        .map(|r| r.channel.name())
         .collect();
     Some(format!(
         "Caution: it makes {} worse{}; the verdict is doubtful — the gain may be another misfit of the baseline that this extension absorbs.",
@@ -471,15 +427,6 @@ pub fn caution(out_of_sample: &[QualityRow]) -> Option<String> {
     ))
 }
 
-/// The channel's name as engineers write it (FX → Fx).
-pub fn pretty(ch: &str) -> &'static str {
-    match ch {
-        "FX" => "Fx",
-        "MZ" => "Mz",
-        _ => "Fy",
-    }
-}
-
 fn capitalise(s: &str) -> String {
     let mut c = s.chars();
     c.next().map_or(String::new(), |f| {
@@ -487,9 +434,70 @@ fn capitalise(s: &str) -> String {
     })
 }
 
-/// The diagnosis: its JSON, the chosen extended tyre and the series the
+/// One candidate in `diagnosis.json` ("effects", the verdict first).
+#[derive(Clone, Debug, Serialize)]
+pub struct EffectReport {
+    pub name: String,
+    /// Pooled held-out gain ([`Evaluation::oos_gain`]).
+    pub score: f64,
+    pub delta_bic: f64,
+    pub n_params: usize,
+    /// The evaluation in words: physics, fitted values, gains, why (not) named.
+    pub evidence: String,
+    pub channels: Vec<ChannelScore>,
+    pub at_bound: Vec<String>,
+    /// Fitted parameters by name (SI; NaN written as null).
+    pub parameters: BTreeMap<String, f64>,
+    pub nrmse_before: NrmseMap,
+    pub nrmse_after: NrmseMap,
+    pub nrmse_before_held_out: NrmseMap,
+    pub nrmse_after_held_out: NrmseMap,
+}
+
+/// The before/after quality tables of `diagnosis.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct QualityReport {
+    /// The model "after" is: the verdict's name.
+    pub model_after: String,
+    /// How the halves were formed, in words.
+    pub split: &'static str,
+    pub in_sample: Vec<QualityRow>,
+    pub out_of_sample: Vec<QualityRow>,
+}
+
+/// `diagnosis.json`, typed.
+#[derive(Clone, Debug, Serialize)]
+pub struct DiagnosisReport {
+    pub verdict: String,
+    pub explanation: String,
+    pub effects: Vec<EffectReport>,
+    pub quality: QualityReport,
+    /// Findings per channel key ("FY").
+    pub locate: BTreeMap<&'static str, Vec<Finding>>,
+    pub candidates_implemented: Vec<&'static str>,
+    pub samples: usize,
+    pub segments: usize,
+    /// How the baseline was obtained (set by the command).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub baseline: Option<String>,
+    /// The plots drawn (set by the command).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plots: Option<Value>,
+}
+
+impl DiagnosisReport {
+    /// As JSON (serialising plain data cannot fail; `Null` if it ever did).
+    pub fn to_json(&self) -> Value {
+        serde_json::to_value(self).unwrap_or(Value::Null)
+    }
+}
+
+/// The diagnosis: its report, the chosen extended tyre and the series the
 /// plots need.
 pub struct Diagnosis {
+    /// The report ([`DiagnosisReport`]).
+    pub report: DiagnosisReport,
+    /// The same as JSON.
     pub json: Value,
     pub verdict: String,
     pub explanation: String,
@@ -498,7 +506,7 @@ pub struct Diagnosis {
     pub baseline_sim: Vec<Forces>,
     pub extended_sim: Vec<Forces>,
     /// Findings per channel (FY, FX, MZ where present).
-    pub findings: Vec<(&'static str, Vec<Finding>)>,
+    pub findings: Vec<(Channel, Vec<Finding>)>,
     /// Accumulated frictional energy per sample (J).
     pub energy: Vec<f64>,
     /// The quality rows: in-sample, out-of-sample.
@@ -521,9 +529,9 @@ pub fn diagnose_with(
     step("replay baseline");
     let base = replay(rec, tyre, opts)?;
     let energy = frictional_energy(rec);
-    let channels: Vec<&'static str> = ["FY", "FX", "MZ"]
+    let channels: Vec<Channel> = [Channel::Fy, Channel::Fx, Channel::Mz]
         .into_iter()
-        .filter(|c| channel_present(rec, c))
+        .filter(|c| channel_present(rec, *c))
         .collect();
     // Guard: an empty analysis must not read as "Nothing is missing".
     if channels.is_empty() || rec.segments.is_empty() {
@@ -569,8 +577,8 @@ pub fn diagnose_with(
     let mut effects = Vec::new();
     let mut order: Vec<usize> = (0..ev.len()).collect();
     order.sort_by_key(|&i| usize::from(ev[i].0.name != verdict));
-    let before = nrmse_map(rec, &base.sim, None);
-    let before_oos = nrmse_map(rec, &base.sim, Some(&test_mask));
+    let before = nrmse_per_channel(rec, &base.sim, None);
+    let before_oos = nrmse_per_channel(rec, &base.sim, Some(&test_mask));
     let mut extended_sim = base.sim.clone();
     for i in order {
         let (e, fitted) = &ev[i];
@@ -579,17 +587,12 @@ pub fn diagnose_with(
         } else {
             fitted.predict(rec)?
         };
-        let params: Map<String, Value> = e
-            .parameters
-            .iter()
-            .map(|(k, v)| (k.clone(), json!(v)))
-            .collect();
-        effects.push(json!({
-            "name": e.name,
-            "score": e.oos_gain,
-            "delta_bic": e.delta_bic,
-            "n_params": e.n_params,
-            "evidence": format!(
+        effects.push(EffectReport {
+            name: e.name.clone(),
+            score: e.oos_gain,
+            delta_bic: e.delta_bic,
+            n_params: e.n_params,
+            evidence: format!(
                 "{}fitted on one half of the segments, scored on the other: removes {:.1} % of the baseline's held-out squared error (per channel: {}; BIC change {:+.1}){}{}",
                 if e.name == "none" {
                     String::new()
@@ -609,14 +612,14 @@ pub fn diagnose_with(
                 },
                 at_bound_note(e)
             ),
-            "channels": e.channels,
-            "at_bound": e.at_bound,
-            "parameters": params,
-            "nrmse_before": before,
-            "nrmse_after": nrmse_map(rec, &sim, None),
-            "nrmse_before_held_out": before_oos,
-            "nrmse_after_held_out": nrmse_map(rec, &sim, Some(&test_mask)),
-        }));
+            channels: e.channels.clone(),
+            at_bound: e.at_bound.clone(),
+            parameters: e.parameters.iter().cloned().collect(),
+            nrmse_before: before.clone(),
+            nrmse_after: nrmse_per_channel(rec, &sim, None),
+            nrmse_before_held_out: before_oos.clone(),
+            nrmse_after_held_out: nrmse_per_channel(rec, &sim, Some(&test_mask)),
+        });
         if Some(i) == verdict_i {
             extended_sim = sim;
         }
@@ -632,28 +635,31 @@ pub fn diagnose_with(
             explanation.push_str(&c);
         }
     }
-    let mut loc = Map::new();
-    for (ch, f) in &findings {
-        loc.insert((*ch).into(), serde_json::to_value(f).unwrap_or(Value::Null));
-    }
+    let locate = findings
+        .iter()
+        .map(|(ch, f)| (ch.key(), f.clone()))
+        .collect();
     let extended = verdict_i.map_or_else(|| tyre.clone(), |i| ev[i].1.tyre().clone());
-    let json = json!({
-        "verdict": verdict,
-        "explanation": explanation,
-        "effects": effects,
-        "quality": {
-            "model_after": verdict,
-            "split": "candidates fitted on one half of the segments (in_sample), scored on the other (out_of_sample); halves alternate within each (kind, load) group",
-            "in_sample": in_sample,
-            "out_of_sample": out_of_sample,
+    let report = DiagnosisReport {
+        verdict: verdict.clone(),
+        explanation: explanation.clone(),
+        effects,
+        quality: QualityReport {
+            model_after: verdict.clone(),
+            split: "candidates fitted on one half of the segments (in_sample), scored on the other (out_of_sample); halves alternate within each (kind, load) group",
+            in_sample: in_sample.clone(),
+            out_of_sample: out_of_sample.clone(),
         },
-        "locate": loc,
-        "candidates_implemented": owned.iter().map(|c| c.name()).collect::<Vec<_>>(),
-        "samples": rec.samples.len(),
-        "segments": rec.segments.len(),
-    });
+        locate,
+        candidates_implemented: owned.iter().map(|c| c.name()).collect(),
+        samples: rec.samples.len(),
+        segments: rec.segments.len(),
+        baseline: None,
+        plots: None,
+    };
     Ok(Diagnosis {
-        json,
+        json: report.to_json(),
+        report,
         verdict,
         explanation,
         extended,

@@ -22,5 +22,7 @@ pub fn eval<T: Real>(model: &Model<T>, c: &Conditions, channel: Channel) -> T {
         Channel::Mx => model.mx_only(c),
         Channel::My => model.my_only(c),
         Channel::Mz => model.solve(c).mz,
+        // Fz is the model's input, not a predicted channel (as `Channel::of`).
+        Channel::Fz => T::from(f64::NAN),
     }
 }

@@ -30,66 +30,15 @@ use super::grad_pure;
 use super::problem::{par_rows, Param, Problem, RowJacobian, Stack};
 use super::solve::{fit_global, FitOptions, FitOutcome, ProgressFn};
 use crate::data::{Recording, Sample, SegmentKind};
-use crate::mf::{Conditions, Form, MfInput, Model, Solution, UseMode};
+use crate::mf::{Conditions, Form, MfInput, Model, UseMode};
 use crate::tir::keys::key_index;
 use crate::tir::MfParams;
 use nalgebra::{Const, DMatrixViewMut, U1};
 use num_dual::{Derivative, DualSVec64};
 use std::ops::Range;
 
-/// A channel the Magic Formula predicts.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Channel {
-    Fx,
-    Fy,
-    Mx,
-    My,
-    Mz,
-}
-
-impl Channel {
-    /// Name as in [`crate::data::SAMPLE_CHANNELS`].
-    pub fn name(self) -> &'static str {
-        match self {
-            Channel::Fx => "Fx",
-            Channel::Fy => "Fy",
-            Channel::Mx => "Mx",
-            Channel::My => "My",
-            Channel::Mz => "Mz",
-        }
-    }
-    /// The measured value of a sample.
-    pub fn measured(self, s: &Sample) -> f64 {
-        match self {
-            Channel::Fx => s.fx,
-            Channel::Fy => s.fy,
-            Channel::Mx => s.mx,
-            Channel::My => s.my,
-            Channel::Mz => s.mz,
-        }
-    }
-    /// The channel of a solution.
-    #[inline]
-    pub fn of<T: Copy>(self, s: &Solution<T>) -> T {
-        match self {
-            Channel::Fx => s.fx,
-            Channel::Fy => s.fy,
-            Channel::Mx => s.mx,
-            Channel::My => s.my,
-            Channel::Mz => s.mz,
-        }
-    }
-    /// The channel of the `f64` hot-path result.
-    pub fn of_forces(self, f: &crate::mf::Forces) -> f64 {
-        match self {
-            Channel::Fx => f.fx,
-            Channel::Fy => f.fy,
-            Channel::Mx => f.mx,
-            Channel::My => f.my,
-            Channel::Mz => f.mz,
-        }
-    }
-}
+/// A channel the Magic Formula predicts (the residual stage's one typed channel).
+pub use crate::residual::Channel;
 
 /// Which fit stage.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -2,7 +2,7 @@
 //! the lag between the imposed slip and the force, seen as the hysteresis
 //! between rising and falling sweeps of a dynamic test, is fitted by
 //! replaying the recording through this project's relaxation model
-//! ([`crate::diagnose::replay`] with [`TransientKind::Relaxation`], the code
+//! ([`crate::residual::replay`] with [`TransientKind::Relaxation`], the code
 //! the FMU runs) and minimising Σ(sim − measured)² of Fy over the pure
 //! lateral segments (σα) and of Fx over the pure longitudinal ones (σκ).
 //!
@@ -31,8 +31,8 @@
 //! finite differences, or panic on user data.
 
 use crate::data::{Recording, SegmentKind};
-use crate::diagnose::replay::{replay, ReplayOptions};
 use crate::mf::{MfInput, Tyre, UseMode};
+use crate::residual::{replay, ReplayOptions};
 use crate::tir::{MfVersion, TyreParams};
 use crate::transient::{tyre_props, TransientKind};
 use std::ops::Range;
@@ -151,7 +151,7 @@ fn rolled_per_sample(subs: &[Recording]) -> f64 {
         .iter()
         .flat_map(|r| r.samples.iter().map(|s| s.time))
         .collect();
-    let h = crate::diagnose::replay::median_spacing(&t);
+    let h = crate::residual::median_spacing(&t);
     if v.is_empty() || !h.is_finite() {
         return 0.0;
     }

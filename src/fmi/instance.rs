@@ -174,9 +174,8 @@ pub fn derive(values: &Values, tyre: &Tyre) -> Result<Derived, String> {
         }
     };
     let kind_s = values.string(string::TRANSIENT);
-    let kind = TransientKind::parse(kind_s).ok_or_else(|| {
-        format!("transient = \"{kind_s}\": expected \"steady\", \"relaxation\" or \"lugre\"")
-    })?;
+    // "file" (the default): the model the tyre file names, steady if none.
+    let kind = TransientKind::resolve(kind_s, tyre.params()).map_err(|e| e.to_string())?;
     let code = values.integers[integer::USE_MODE];
     let use_mode = u32::try_from(code)
         .ok()

@@ -155,7 +155,7 @@ mod tests {
             "p = 0 is the 'file INFLPRES' sentinel"
         );
         assert_eq!(v.integers[integer::USE_MODE], 111);
-        assert_eq!(v.string(string::TRANSIENT), "steady");
+        assert_eq!(v.string(string::TRANSIENT), "file");
         assert_eq!(v.string(string::INPUT_MODE), "velocities");
     }
 }

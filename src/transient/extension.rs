@@ -29,6 +29,16 @@
 //! Pressure, camber and the rolling radius need no hook: they are the MF's
 //! own keys (PPX*/PPY*, the camber terms, Q_RE0/FREFF of Re(Fz)).
 //!
+//! # The transient model a file asks for
+//! `[TYREKIT]` `TRANSIENT = 'relaxation'` (or `'lugre'`, `'steady'`) names
+//! the transient model the file's physics needs ([`file_transient`]): a
+//! relaxation or LuGre finding of `tyrekit diagnose` writes it into
+//! `extended.tir`, and the FMU's `transient = "file"` (its default) and
+//! `tyrekit replay` without `--transient` run that model. A file without
+//! the key runs `steady`. The standard `USE_MODE` key (ADAMS' tyre-use
+//! switch: 4, 14, 114, 124, 2 in the shared files) is not read for this:
+//! files that carry it keep today's behaviour.
+//!
 //! Must never: change anything for a tyre without these keys (the hook is
 //! `None`, the outputs stay bit-identical), allocate, or return a
 //! non-positive scale.
@@ -46,6 +56,36 @@ pub const LOAD_KEYS: [&str; 3] = ["MU_DFZ1", "MU_DFZ2", "K_DFZ1"];
 pub const THERMAL_SECTION: &str = "THERMAL";
 /// Keys of [`THERMAL_SECTION`].
 pub const THERMAL_KEYS: [&str; 6] = ["CAPACITY", "COOLING", "SHARE", "MU_T0", "MU_T1", "MU_T2"];
+/// The project's own section of the tyre file (settings, not physics).
+pub const PROJECT_SECTION: &str = "TYREKIT";
+/// Key of [`PROJECT_SECTION`]: the transient model the file needs
+/// (`'steady'`, `'relaxation'` or `'lugre'`; see the module docs).
+pub const TRANSIENT_KEY: &str = "TRANSIENT";
+
+/// The transient model the file asks for ([`TRANSIENT_KEY`]), None when it
+/// says nothing. Errors name the file, key and accepted values.
+pub fn file_transient(t: &TyreParams) -> crate::Result<Option<super::TransientKind>> {
+    let Some(v) = t.extra(PROJECT_SECTION, TRANSIENT_KEY) else {
+        return Ok(None);
+    };
+    let text = v.as_str().unwrap_or("");
+    super::TransientKind::parse(text)
+        .map(Some)
+        .ok_or_else(|| crate::Error::Tir {
+            file: t.source.clone(),
+            line: 0,
+            key: TRANSIENT_KEY.into(),
+            message: format!(
+                "[{PROJECT_SECTION}] {TRANSIENT_KEY} = {v:?}: expected 'steady', 'relaxation' or 'lugre'"
+            ),
+        })
+}
+
+/// Write the transient model `kind` into the file's [`PROJECT_SECTION`].
+pub fn set_file_transient(t: &mut TyreParams, kind: super::TransientKind) {
+    t.set_string(PROJECT_SECTION, TRANSIENT_KEY, kind.name());
+}
+
 /// Temperature scale of the friction polynomial (K).
 pub const T_SCALE: f64 = 50.0;
 /// Smallest scale the hook returns (a guard, not physics).
@@ -240,5 +280,54 @@ impl Extension {
             let t0 = prev.x[SLOT_TEMP];
             next.x[SLOT_TEMP] = eq + (t0 - eq) * (-dt / m.time_constant()).exp();
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::transient::TransientKind;
+
+    /// The built-in file plus `extra` text.
+    fn with(extra: &str) -> TyreParams {
+        let text = format!("{}\n{extra}", crate::tir::BUILTIN_TIR);
+        TyreParams::from_tir_str(&text, "test.tir").unwrap()
+    }
+
+    /// `file` resolves to the key's model, `steady` without the key; the
+    /// ADAMS USE_MODE switch (124 here, as in shared files) is not read;
+    /// a written key reads back; a bad value is refused naming the key.
+    #[test]
+    fn transient_key_selects_the_model() {
+        let plain = with("");
+        assert_eq!(file_transient(&plain).unwrap(), None);
+        assert_eq!(
+            TransientKind::resolve("file", &plain).unwrap(),
+            TransientKind::Steady
+        );
+        let text = crate::tir::BUILTIN_TIR.replacen("[MODEL]", "[MODEL]\nUSE_MODE = 124", 1);
+        let adams = TyreParams::from_tir_str(&text, "adams.tir").unwrap();
+        assert_eq!(adams.get("USE_MODE"), Some(124.0));
+        assert_eq!(
+            TransientKind::resolve("file", &adams).unwrap(),
+            TransientKind::Steady
+        );
+        let relax = with("[TYREKIT]\nTRANSIENT = 'relaxation'\n");
+        assert_eq!(
+            TransientKind::resolve("FILE", &relax).unwrap(),
+            TransientKind::Relaxation
+        );
+        // An explicit value overrides the file.
+        assert_eq!(
+            TransientKind::resolve("lugre", &relax).unwrap(),
+            TransientKind::LuGre
+        );
+        let mut w = plain.clone();
+        set_file_transient(&mut w, TransientKind::LuGre);
+        let back = TyreParams::from_tir_str(&w.to_tir_string(), "w.tir").unwrap();
+        assert_eq!(file_transient(&back).unwrap(), Some(TransientKind::LuGre));
+        let bad = with("[TYREKIT]\nTRANSIENT = 'fast'\n");
+        let e = file_transient(&bad).unwrap_err().to_string();
+        assert!(e.contains("TRANSIENT") && e.contains("relaxation"), "{e}");
     }
 }

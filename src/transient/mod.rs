@@ -96,6 +96,25 @@ impl TransientKind {
             _ => None,
         }
     }
+    /// The value `file` of the FMU's `transient` parameter and of
+    /// `replay --transient`: the model the tyre file names
+    /// ([`extension::file_transient`]), `steady` when it names none.
+    pub const FROM_FILE: &'static str = "file";
+
+    /// Resolve a `transient` setting for `tyre`: `file` (see
+    /// [`TransientKind::FROM_FILE`]) or an explicit `steady` | `relaxation`
+    /// | `lugre`. The error names the value and what is accepted.
+    pub fn resolve(setting: &str, tyre: &crate::tir::TyreParams) -> crate::Result<Self> {
+        if setting.trim().eq_ignore_ascii_case(Self::FROM_FILE) {
+            return Ok(extension::file_transient(tyre)?.unwrap_or_default());
+        }
+        Self::parse(setting).ok_or_else(|| {
+            crate::Error::Input(format!(
+                "transient = \"{setting}\": expected \"file\" (as the tyre file says), \"steady\", \"relaxation\" or \"lugre\""
+            ))
+        })
+    }
+
     /// The name as accepted by [`TransientKind::parse`].
     pub fn name(self) -> &'static str {
         match self {

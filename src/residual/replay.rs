@@ -20,22 +20,25 @@
 //!   equilibrium, not at an artificial zero deflection.
 //! * A sample whose core inputs (Vx, Fz, α) are missing or refused by the
 //!   model gets NaN outputs and ends its run (the next good sample starts a
-//!   new one). Missing κ, γ, φt read as 0, missing pressure as 0 (= the
-//!   .tir's INFLPRES), missing Ω as (1+κ)·Vx / R0.
+//!   new one). Missing optional inputs as in [`super::input`].
 //!
-//! Slips are prescribed ([`InputMode::Slips`]): rigs impose κ and α and
-//! record them; velocities would recompute κ through a model Re that the
-//! rig's own Re definition need not share.
+//! By default slips are prescribed ([`InputMode::Slips`]): rigs impose κ
+//! and α and record them (the diagnosis scores its candidates so).
+//! With [`ReplayOptions::wheel_speed`] and a recording that has the wheel
+//! speed Ω, the model runs as the FMU is used by default
+//! ([`InputMode::Velocities`]): κ = (Ω·Re(Fz) − Vx)/|Vx| with the tyre's
+//! own effective rolling radius (so a rolling-radius finding changes the
+//! replay), α from Vy = tan α·|Vx|; without Ω the slips stay prescribed.
 //!
 //! Must never: allocate per sample beyond the output vectors, or carry a
 //! state across a gap.
 
+use super::input::wheel_input;
 use crate::data::Recording;
 use crate::error::Result;
 use crate::mf::{Forces, Tyre, UseMode};
 use crate::transient::{
-    InputMode, TransientConfig, TransientKind, TransientModel, TransientOptions, WheelInput,
-    WheelOutput,
+    InputMode, TransientConfig, TransientKind, TransientModel, TransientOptions, WheelOutput,
 };
 use std::io::Write;
 
@@ -49,6 +52,9 @@ pub struct ReplayOptions {
     pub gap_factor: f64,
     /// Duration (s) of the settling step after a reset (0: start at rest).
     pub settle_time: f64,
+    /// Take κ from the recorded wheel speed and the tyre's Re(Fz) (the
+    /// FMU's velocities input) when the recording has Ω (see the module docs).
+    pub wheel_speed: bool,
 }
 
 impl Default for ReplayOptions {
@@ -59,6 +65,7 @@ impl Default for ReplayOptions {
             options: TransientOptions::default(),
             gap_factor: 5.0,
             settle_time: 5.0,
+            wheel_speed: false,
         }
     }
 }
@@ -90,32 +97,13 @@ pub fn median_spacing(t: &[f64]) -> f64 {
     *d.select_nth_unstable_by(m, f64::total_cmp).1
 }
 
-/// The model's input for one recorded sample (None when a core input is missing).
-pub fn wheel_input(tyre: &Tyre, s: &crate::data::Sample) -> Option<WheelInput> {
-    if !(s.vx.is_finite() && s.fz.is_finite() && s.alpha.is_finite()) {
-        return None;
-    }
-    let or0 = |x: f64| if x.is_finite() { x } else { 0.0 };
-    let kappa = or0(s.kappa);
-    let omega = if s.omega.is_finite() {
-        s.omega
+/// The input mode a replay of `rec` runs with (see the module docs).
+pub fn input_mode(rec: &Recording, opts: &ReplayOptions) -> InputMode {
+    if opts.wheel_speed && rec.has("omega") {
+        InputMode::Velocities
     } else {
-        let r0 = tyre.params().p.unloaded_radius;
-        let r0 = if r0.is_finite() && r0 > 0.0 { r0 } else { 0.3 };
-        (1.0 + kappa) * s.vx / r0
-    };
-    Some(WheelInput {
-        vx: s.vx,
-        vy: 0.0,
-        omega,
-        fz: s.fz,
-        gamma: or0(s.gamma),
-        p: or0(s.p),
-        phit: or0(s.phit),
-        mu_scale: 0.0,
-        kappa_in: kappa,
-        alpha_in: s.alpha,
-    })
+        InputMode::Slips
+    }
 }
 
 /// Replay `rec` through `tyre` (see the module docs for time base and resets).
@@ -131,7 +119,7 @@ pub fn replay(rec: &Recording, tyre: &Tyre, opts: &ReplayOptions) -> Result<Repl
     let mut model = TransientModel::with_options(
         TransientConfig {
             kind: opts.kind,
-            input_mode: InputMode::Slips,
+            input_mode: input_mode(rec, opts),
             use_mode: opts.use_mode,
         },
         opts.options,

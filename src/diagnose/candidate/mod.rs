@@ -1,0 +1,172 @@
+//! candidate — the extensions the diagnosis can name: each a parametrised
+//! model with a physical meaning, fitted to a recording on top of a baseline
+//! tyre, written into the tyre file (standard keys or a documented section,
+//! see [`crate::transient::extension`]) so that the FMU and `replay` simulate
+//! exactly what was scored, and scored out of sample with an information
+//! criterion so that extra parameters alone never win.
+//!
+//! # Candidates ([`all`])
+//! | name | parameters (tyre file) | fitted how |
+//! |------|------------------------|------------|
+//! | `none` | – | the baseline |
+//! | `relaxation` | LONGITUDINAL_STIFFNESS, LATERAL_STIFFNESS (σ = K/C; LSGKP, LSGAL for MF 5.2/PAC2002) | LM, replayed transient |
+//! | `lugre` | `[LUGRE]` SIGMA0X, SIGMA0Y (bristle stiffness), MUS (Stribeck ratio) | LM, replayed transient |
+//! | `thermal` | `[THERMAL]` CAPACITY (time constant with COOLING = 40 W/K, SHARE = 0.5), MU_T0..2 | LM, replayed (tread-temperature state) |
+//! | `load_sensitivity` | `[LOAD_SENSITIVITY]` MU_DFZ1, MU_DFZ2, K_DFZ1 | LM on a subsample (static) |
+//! | `pressure` | PPX1, PPX3, PPX4 (with Fx data), PPY1, PPY3, PPY4 (with Fy/Mz data) (MF 6.x only: MF 5.2/PAC2002 have no pressure terms; needs two pressures) | LM, static |
+//! | `speed_friction` | LMUV (V0 = LONGVL) | LM, static |
+//! | `rolling_radius` | Q_RE0, FREFF (Re(Fz)); κ re-derived as (1+κ)·Re/Re_baseline − 1 | LM, static |
+//! | `camber` | PDY3, PKY6, PKY7 (PKY3, PHY3 for MF 5.2/PAC2002), PVY3, QHZ3, QDZ8, QDZ9 | LM, static |
+//!
+//! LM = the crate's one Levenberg–Marquardt ([`crate::fit::lm`], bounded by
+//! projection) behind [`crate::fit::Problem`]; the candidate's Jacobian is
+//! a forward difference of the replay (the transient models are `f64`
+//! code, see [`param`]), ≤ 7 parameters. Static candidates (no state) are
+//! fitted on at most [`STATIC_SAMPLES`] fit-half samples and never replay
+//! a transient.
+//!
+//! # Files
+//! One file per candidate (its [`Spec`] and its description in words),
+//! [`param`] (the parametrised candidate and its fit), the statistics
+//! ([`statistics`]: split, input smoothing, weights, evaluation) and the
+//! verdict rule ([`selection`]).
+//!
+//! # Scoring ([`evaluate`]) and the verdict ([`select`])
+//! * Split ([`split`]): segments are grouped by (kind, load) and alternate
+//!   between the fit and the score half within each group in time order,
+//!   successive groups starting on opposite halves, so that the factors
+//!   nested inside (pressure, inclination, drive/brake slip angle) alternate
+//!   too; a level of load, pressure or inclination left without a fit
+//!   segment gets one. A condition-level effect (pressure, load) is thus
+//!   fitted on every level and scored on the others' combinations, and
+//!   time-dependent effects see early and late segments in both halves.
+//!   (Plain even/odd parity puts every segment of a level on one side when
+//!   the programme's inner loop has an even length.)
+//! * Channels Fx, Fy, Mz, each scored against its own error level.
+//!   Constant per-channel offsets (sensor zero offsets) are nuisance, not
+//!   physics: each model's offsets are estimated on the fit half and removed
+//!   on both halves, for the baseline too.
+//! * Fitting ([`fit_weights`]): each channel's squared residual weighted by
+//!   1/the baseline's mean squared residual in that channel (the Gaussian
+//!   likelihood with one variance per channel, at the baseline). Only the
+//!   parameters acting on a channel with data are fitted ([`Param::channels`]:
+//!   PPX* need Fx), `pressure` and `camber` only when the fit half spans two
+//!   levels of pressure or inclination ([`Spec::levels`]); a fitted
+//!   parameter ending at a bound is reported ([`Fitted::at_bound`]).
+//! * Gains: per channel, the relative drop of its held-out (and fit-half)
+//!   SSE against the baseline's ([`ChannelScore`]); pooled, 1 − the
+//!   sample-weighted geometric mean of the channels' SSE ratios (the
+//!   per-sample log-likelihood ratio), so a badly fitted channel cannot
+//!   dominate a well fitted one. BIC over both halves,
+//!   n_eff·ln(SSE ratio) + k·ln(n_eff), n_eff = recorded seconds
+//!   ([`DECORRELATION_TIME`]), k = parameters fitted.
+//! * Verdict ([`select`], [`qualifies`]): a candidate qualifies when some
+//!   channel's held-out error falls by more than [`MIN_GAIN`], none rises by
+//!   more than [`MAX_LOSS`] (physics that is missing makes no channel worse;
+//!   a candidate that trades one channel for another absorbs a misfit), the
+//!   pooled held-out and in-sample gains are positive, and its BIC falls;
+//!   among those the lowest BIC wins, otherwise `none`. The held-out test
+//!   keeps noise and over-fitting out; BIC then prefers the fewer parameters
+//!   between explanations that generalise alike.
+//!
+//! Must never: let a candidate see the held-out segments' forces while
+//! fitting (their inputs may drive a state), or panic on a recording with
+//! missing channels.
+
+mod camber;
+mod load_sensitivity;
+mod lugre;
+pub mod param;
+mod pressure;
+mod relaxation;
+mod rolling_radius;
+pub mod selection;
+mod speed_friction;
+pub mod statistics;
+mod thermal;
+
+/// Index of Fx, Fy, Mz in [`crate::residual::Channel::SCORED`] (and in the weights).
+pub use crate::residual::{FX, FY, MZ};
+pub use param::{NoneCandidate, Param, ParamCandidate, Spec, Target, STATIC_SAMPLES};
+pub use selection::{channels_in_words, qualifies, select, why_not, MAX_LOSS, MIN_GAIN};
+pub use statistics::{
+    evaluate, fit_weights, held_out_sse, smoothed_inputs, split, ChannelScore, Evaluation,
+    DECORRELATION_TIME, SMOOTH_HALF_WIDTH,
+};
+
+use crate::data::Recording;
+use crate::error::Result;
+use crate::mf::{Forces, Tyre};
+use crate::residual::ReplayOptions;
+
+/// A fitted extension: its parameters and its predictions.
+pub trait Fitted: Send + Sync {
+    /// Named physical parameters (SI).
+    fn parameters(&self) -> Vec<(String, f64)>;
+    /// Simulated forces for every sample of `rec`.
+    fn predict(&self, rec: &Recording) -> Result<Vec<Forces>>;
+    /// The extended tyre to write as `extended.tir`.
+    fn tyre(&self) -> &Tyre;
+    /// Fitted parameters that ended at a bound of their range, in words
+    /// ("PPY3 = -3 (its lower bound)"): the data pushed them beyond what the
+    /// candidate allows, so the value is a limit, not an estimate.
+    fn at_bound(&self) -> Vec<String> {
+        Vec::new()
+    }
+}
+
+/// A candidate extension.
+pub trait Candidate: Send + Sync {
+    fn name(&self) -> &'static str;
+    fn n_params(&self) -> usize;
+    /// The physics in one line, as a tyre engineer would say it
+    /// ("transient slip lag"): used in the explanation of a verdict.
+    fn physics(&self) -> &'static str {
+        self.name()
+    }
+    /// The fitted extension in words with its key parameter(s), e.g.
+    /// "a relaxation length of 0.31 m (×1.2 the file's)".
+    fn describe(&self, fitted: &dyn Fitted) -> String {
+        fitted
+            .parameters()
+            .iter()
+            .map(|(k, v)| format!("{k} = {v:.4}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+    /// Fit on the samples where `mask` is true (the rest is never looked
+    /// at), each channel's squared residual weighted by `w` (in
+    /// [`crate::residual::Channel::SCORED`] order; see [`fit_weights`]).
+    /// A channel of weight 0 carries no data: parameters acting only on it
+    /// are not fitted.
+    fn fit(
+        &self,
+        rec: &Recording,
+        baseline: &Tyre,
+        opts: &ReplayOptions,
+        mask: &[bool],
+        w: &[f64; 3],
+    ) -> Result<Box<dyn Fitted>>;
+}
+
+/// All three scored channels.
+pub const ALL_CHANNELS: &[usize] = &[FX, FY, MZ];
+
+/// Weighted SSE of Fx, Fy, Mz over masked samples (see [`crate::residual::sse`]).
+pub use crate::residual::sse;
+
+/// Every candidate the diagnosis weighs, `none` first. The one registry:
+/// the report, the CLI and the proof tests all take their list from here.
+pub fn all() -> Vec<Box<dyn Candidate>> {
+    vec![
+        Box::new(NoneCandidate),
+        Box::new(relaxation::candidate()),
+        Box::new(lugre::candidate()),
+        Box::new(thermal::candidate()),
+        Box::new(load_sensitivity::candidate()),
+        Box::new(pressure::candidate()),
+        Box::new(speed_friction::candidate()),
+        Box::new(rolling_radius::candidate()),
+        Box::new(camber::candidate()),
+    ]
+}

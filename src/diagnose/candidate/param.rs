@@ -1,0 +1,560 @@
+//! param — the parametrised candidate: a [`Spec`] (which tyre-file keys or
+//! project-section values it fits, their ranges, the transient model to
+//! replay with) applied to a baseline tyre, fitted by the crate's one
+//! Levenberg–Marquardt ([`crate::fit::lm`]) through a [`crate::fit::Problem`]
+//! whose residuals are the replayed model's, and the baseline itself
+//! ([`NoneCandidate`]).
+//!
+//! Must never: look at a sample outside the fit mask while fitting, fit a
+//! parameter whose channels carry no data, or report a value at a bound
+//! without saying so ([`Fitted::at_bound`]).
+
+use super::{Candidate, Fitted, ALL_CHANNELS};
+use crate::data::Recording;
+use crate::error::Result;
+use crate::mf::{Forces, MfInput, Tyre};
+use crate::residual::{mf_input, replay, Channel, ReplayOptions};
+use crate::tir::MfVersion;
+use crate::transient::extension::set_file_transient;
+use crate::transient::{LuGreParams, TransientKind};
+
+/// Most fit-half samples a static candidate is fitted on.
+pub const STATIC_SAMPLES: usize = 4000;
+
+/// A fitted model: a tyre, how to replay it, and (rolling radius) whether κ
+/// is re-derived from the tyre's effective rolling radius.
+struct Model {
+    tyre: Tyre,
+    base: Tyre,
+    opts: ReplayOptions,
+    kappa_re: bool,
+    params: Vec<(String, f64)>,
+    at_bound: Vec<String>,
+}
+
+/// The recording with κ re-derived from `tyre`'s effective rolling radius:
+/// κ' = (1 + κ)·Re(tyre)/Re(base) − 1, i.e. the slip the tyre sees at the
+/// recorded wheel speed Ω = (1 + κ)·Vx/Re(base) when the recording's κ was
+/// derived with the baseline's radius (what the FMU does from velocities).
+fn rerolled(rec: &Recording, base: &Tyre, tyre: &Tyre, opts: &ReplayOptions) -> Recording {
+    let mut out = rec.clone();
+    for s in &mut out.samples {
+        if !(s.fz.is_finite() && s.vx.is_finite() && s.kappa.is_finite()) {
+            continue;
+        }
+        // Re depends on load, speed, pressure, wheel speed; not on slip.
+        let mi = MfInput {
+            kappa: 0.0,
+            alpha: 0.0,
+            phit: 0.0,
+            ..mf_input(s)
+        };
+        let rb = base.slip_properties(&mi, opts.use_mode).re;
+        let rt = tyre.slip_properties(&mi, opts.use_mode).re;
+        let k = (1.0 + s.kappa) * rt / rb - 1.0;
+        if k.is_finite() {
+            s.kappa = k;
+        }
+    }
+    out
+}
+
+impl Model {
+    fn sim(&self, rec: &Recording) -> Result<Vec<Forces>> {
+        if self.kappa_re {
+            let r = rerolled(rec, &self.base, &self.tyre, &self.opts);
+            Ok(replay(&r, &self.tyre, &self.opts)?.sim)
+        } else {
+            Ok(replay(rec, &self.tyre, &self.opts)?.sim)
+        }
+    }
+}
+
+impl Fitted for Model {
+    fn parameters(&self) -> Vec<(String, f64)> {
+        self.params.clone()
+    }
+    fn predict(&self, rec: &Recording) -> Result<Vec<Forces>> {
+        self.sim(rec)
+    }
+    fn tyre(&self) -> &Tyre {
+        &self.tyre
+    }
+    fn at_bound(&self) -> Vec<String> {
+        self.at_bound.clone()
+    }
+}
+
+/// The baseline itself.
+pub struct NoneCandidate;
+
+impl Candidate for NoneCandidate {
+    fn name(&self) -> &'static str {
+        "none"
+    }
+    fn n_params(&self) -> usize {
+        0
+    }
+    fn physics(&self) -> &'static str {
+        "nothing beyond the baseline: what is left is noise"
+    }
+    fn describe(&self, _: &dyn Fitted) -> String {
+        "the baseline model as it is".into()
+    }
+    fn fit(
+        &self,
+        _: &Recording,
+        baseline: &Tyre,
+        opts: &ReplayOptions,
+        _: &[bool],
+        _: &[f64; 3],
+    ) -> Result<Box<dyn Fitted>> {
+        Ok(Box::new(Model {
+            tyre: baseline.clone(),
+            base: baseline.clone(),
+            opts: *opts,
+            kappa_re: false,
+            params: vec![],
+            at_bound: vec![],
+        }))
+    }
+}
+
+/// Golden-section minimum of `f` on [lo, hi] in ln-space (n evaluations).
+pub(super) fn golden_log(lo: f64, hi: f64, n: usize, mut f: impl FnMut(f64) -> f64) -> f64 {
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut a, mut b) = (lo.ln(), hi.ln());
+    let mut c = b - g * (b - a);
+    let mut d = a + g * (b - a);
+    let (mut fc, mut fd) = (f(c.exp()), f(d.exp()));
+    for _ in 0..n {
+        if fc < fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - g * (b - a);
+            fc = f(c.exp());
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + g * (b - a);
+            fd = f(d.exp());
+        }
+    }
+    (0.5 * (a + b)).exp()
+}
+
+/// Zero-slip properties of `t` at its nominal load, 60 km/h, no camber.
+pub(super) fn nominal_props(t: &Tyre, opts: &ReplayOptions) -> crate::mf::SlipProps {
+    let p = &t.params().p;
+    let fz0 = if p.fnomin > 0.0 { p.fnomin } else { 4000.0 };
+    t.slip_properties(
+        &MfInput {
+            fz: fz0,
+            vx: 16.7,
+            ..Default::default()
+        },
+        opts.use_mode,
+    )
+}
+
+/// A fitted parameter's value by name (NaN if absent).
+pub(super) fn param(f: &dyn Fitted, name: &str) -> f64 {
+    f.parameters()
+        .iter()
+        .find(|(k, _)| k == name)
+        .map_or(f64::NAN, |(_, v)| *v)
+}
+
+/// Where a parameter lives in the tyre file.
+#[derive(Clone, Copy, Debug)]
+pub enum Target {
+    /// A key of the MF key table (PPY3, LMUV, FREFF …).
+    Key(&'static str),
+    /// A key of a section of this project's own (`[THERMAL]` …).
+    Section(&'static str, &'static str),
+}
+
+/// One fitted parameter: its name, where it goes, start, bounds, the
+/// finite-difference step (also its natural scale) and the channels it acts
+/// on (indices into [`Channel::SCORED`]): a parameter is fitted only when one of
+/// them carries data in the fit half — PPX* of the pressure candidate on a
+/// cornering-only recording would otherwise wander to a bound, fitted to
+/// nothing.
+#[derive(Clone, Debug)]
+pub struct Param {
+    pub name: &'static str,
+    pub targets: Vec<Target>,
+    pub init: f64,
+    pub lo: f64,
+    pub hi: f64,
+    pub h: f64,
+    pub channels: &'static [usize],
+}
+
+impl Param {
+    /// The same parameter acting on `channels` only.
+    pub fn on(mut self, channels: &'static [usize]) -> Param {
+        self.channels = channels;
+        self
+    }
+}
+
+/// How a parametrised candidate applies to one baseline tyre.
+#[derive(Clone, Debug, Default)]
+pub struct Spec {
+    pub params: Vec<Param>,
+    /// Values written as they are (not fitted).
+    pub fixed: Vec<(Target, f64)>,
+    /// Transient model to replay with (None: the baseline's).
+    pub kind: Option<TransientKind>,
+    /// The model has a state: replay the whole recording in time order.
+    pub sequential: bool,
+    /// Re-derive κ from the tyre's effective rolling radius.
+    pub kappa_re: bool,
+    /// Before LM, scan one common factor on the start values of the first
+    /// `prescan` parameters (golden section in ln-space, ×0.1…×10): for
+    /// parameters that set a length scale together (relaxation lengths,
+    /// bristle stiffnesses), where the cost is far from quadratic around the
+    /// file's values. 0: no scan.
+    pub prescan: usize,
+    /// A condition the parameters act through (inflation pressure,
+    /// inclination): (its value on a segment, the width of one level). The
+    /// candidate is fitted only when the fit half spans at least two levels
+    /// — at one pressure the pressure terms can only fit sensor noise on the
+    /// recorded pressure and end at a bound.
+    pub levels: Option<(fn(&crate::data::Segment) -> f64, f64)>,
+}
+
+/// Distinct levels of `levels` among the segments overlapping `mask`.
+fn level_count(
+    rec: &Recording,
+    mask: &[bool],
+    levels: (fn(&crate::data::Segment) -> f64, f64),
+) -> usize {
+    let (get, width) = levels;
+    let mut seen: Vec<i64> = rec
+        .segments
+        .iter()
+        .filter(|g| mask.get(g.start).copied().unwrap_or(false))
+        .map(get)
+        .filter(|x| x.is_finite())
+        .map(|x| (x / width).round() as i64)
+        .collect();
+    seen.sort_unstable();
+    seen.dedup();
+    seen.len()
+}
+
+fn set(p: &mut crate::tir::TyreParams, t: Target, v: f64) -> Result<()> {
+    match t {
+        Target::Key(k) => p.set(k, v),
+        Target::Section(s, k) => {
+            p.extra_section(s).set(k, v);
+            Ok(())
+        }
+    }
+}
+
+/// The baseline with the spec's fixed values and parameters `theta`.
+fn apply(base: &Tyre, spec: &Spec, theta: &[f64]) -> Result<Tyre> {
+    let mut p = base.params().clone();
+    for (t, v) in &spec.fixed {
+        set(&mut p, *t, *v)?;
+    }
+    for (q, v) in spec.params.iter().zip(theta) {
+        for t in &q.targets {
+            set(&mut p, *t, *v)?;
+        }
+    }
+    // The file names the transient model it needs, so the FMU and `replay`
+    // run it by default.
+    if let Some(k) = spec.kind {
+        set_file_transient(&mut p, k);
+    }
+    Tyre::new(p)
+}
+
+/// Most outer iterations (Jacobians) of a candidate's fit: each is one
+/// replay per free parameter, and the candidates start at the file's
+/// values or a scanned common factor, a few steps from their optimum.
+pub const LM_ITERATIONS: usize = 12;
+
+/// Relative cost reduction below which a candidate's fit stops: 10⁻⁵ of
+/// the weighted SSE is far below what any held-out gain of
+/// [`super::MIN_GAIN`] = 5 % needs.
+pub const LM_FTOL: f64 = 1e-5;
+
+/// A candidate's least-squares problem for the crate's LM: r(θ) is the
+/// weighted, per-channel centred residual of the replayed model; ∂r/∂θ is
+/// a forward difference with each parameter's own step [`Param::h`]
+/// (backward when the forward step would leave the range) — stated here,
+/// not hidden: the replay runs the FMU's `f64` transient models, which have
+/// no dual-number form, and a forward difference of a deterministic replay
+/// is accurate to ~h relative to the curvature, plenty for ≤ 7 parameters
+/// (Madsen, Nielsen & Tingleff, *Methods for non-linear least squares
+/// problems*, 2004, §3.3). A θ whose model cannot be built or replayed has
+/// non-finite residuals (LM rejects the step); its difference column is 0.
+struct FdProblem<F: Fn(&[f64]) -> Option<Vec<f64>>> {
+    params: Vec<crate::fit::Param>,
+    steps: Vec<f64>,
+    m: usize,
+    resid: F,
+}
+
+impl<F: Fn(&[f64]) -> Option<Vec<f64>>> crate::fit::Problem for FdProblem<F> {
+    fn params(&self) -> &[crate::fit::Param] {
+        &self.params
+    }
+    fn n_residuals(&self) -> usize {
+        self.m
+    }
+    fn residuals(&self, theta: &[f64], r: &mut [f64]) {
+        match (self.resid)(theta) {
+            Some(v) if v.len() == r.len() => r.copy_from_slice(&v),
+            _ => r.fill(f64::NAN),
+        }
+    }
+    fn jacobian(
+        &self,
+        theta: &[f64],
+        cols: &[usize],
+        r: &mut [f64],
+        jac: &mut nalgebra::DMatrixViewMut<f64>,
+    ) {
+        self.residuals(theta, r);
+        let mut t = theta.to_vec();
+        for (k, &j) in cols.iter().enumerate() {
+            let q = &self.params[j];
+            let h = if theta[j] + self.steps[j] <= q.upper {
+                self.steps[j]
+            } else {
+                -self.steps[j]
+            };
+            t[j] = theta[j] + h;
+            let col = (self.resid)(&t).filter(|v| v.len() == r.len());
+            t[j] = theta[j];
+            for i in 0..r.len() {
+                jac[(i, k)] = col.as_ref().map_or(0.0, |v| (v[i] - r[i]) / h);
+            }
+        }
+    }
+}
+
+/// Minimise Σ r(θ)² over `params` (start [`Param::init`] clamped into its
+/// range) with [`crate::fit::lm::minimize`]; the start when the start
+/// cannot be replayed or LM refuses the problem.
+fn fit_lm(params: &[Param], resid: impl Fn(&[f64]) -> Option<Vec<f64>>) -> Vec<f64> {
+    let start: Vec<f64> = params.iter().map(|q| q.init.clamp(q.lo, q.hi)).collect();
+    let Some(r0) = resid(&start) else {
+        return start;
+    };
+    let problem = FdProblem {
+        params: params
+            .iter()
+            .zip(&start)
+            .map(|(q, &v)| crate::fit::Param::new(q.name, v, q.lo, q.hi))
+            .collect(),
+        steps: params.iter().map(|q| q.h).collect(),
+        m: r0.len(),
+        resid,
+    };
+    let opts = crate::fit::LmOptions {
+        max_iter: LM_ITERATIONS,
+        ftol: LM_FTOL,
+        lambda0: 1e-3,
+        ..Default::default()
+    };
+    let free = vec![true; params.len()];
+    crate::fit::lm::minimize(&problem, &start, &free, &opts, None).map_or(start, |r| r.theta)
+}
+
+/// A candidate fitted by Levenberg–Marquardt ([`fit_lm`]) over the parameters of a
+/// [`Spec`] (built per baseline tyre; None: not applicable to that tyre, the
+/// fit is then the baseline itself).
+pub struct ParamCandidate {
+    pub name: &'static str,
+    pub physics: &'static str,
+    pub n: usize,
+    pub spec: fn(&Tyre, &ReplayOptions) -> Option<Spec>,
+    pub words: fn(&dyn Fitted) -> String,
+}
+
+/// Fit-half sample indices, thinned to at most `max` (evenly).
+fn thin(mask: &[bool], max: usize) -> Vec<usize> {
+    let idx: Vec<usize> = (0..mask.len()).filter(|&i| mask[i]).collect();
+    let step = idx.len().div_ceil(max.max(1)).max(1);
+    idx.into_iter().step_by(step).collect()
+}
+
+impl Candidate for ParamCandidate {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+    fn n_params(&self) -> usize {
+        self.n
+    }
+    fn physics(&self) -> &'static str {
+        self.physics
+    }
+    fn describe(&self, f: &dyn Fitted) -> String {
+        (self.words)(f)
+    }
+    fn fit(
+        &self,
+        rec: &Recording,
+        baseline: &Tyre,
+        opts: &ReplayOptions,
+        mask: &[bool],
+        w: &[f64; 3],
+    ) -> Result<Box<dyn Fitted>> {
+        let Some(spec) = (self.spec)(baseline, opts) else {
+            return NoneCandidate.fit(rec, baseline, opts, mask, w);
+        };
+        // Only the parameters acting on a channel with data are fitted; the
+        // others stay at their start (the file's value).
+        let free: Vec<usize> = (0..spec.params.len())
+            .filter(|&i| spec.params[i].channels.iter().any(|&c| w[c] > 0.0))
+            .collect();
+        let one_level = spec.levels.is_some_and(|l| level_count(rec, mask, l) < 2);
+        if free.is_empty() || one_level {
+            return NoneCandidate.fit(rec, baseline, opts, mask, w);
+        }
+        let mut ro = *opts;
+        if let Some(k) = spec.kind {
+            ro.kind = k;
+        }
+        let sequential = spec.sequential || ro.kind != TransientKind::Steady;
+        // Static: a thinned copy of the fit half (no state, so order and
+        // gaps do not matter). Sequential: the whole recording replayed,
+        // residuals on the fit half only.
+        let (work, idx): (Recording, Vec<usize>) = if sequential {
+            (rec.clone(), thin(mask, 4 * STATIC_SAMPLES))
+        } else {
+            let idx = thin(mask, STATIC_SAMPLES);
+            let sub = Recording {
+                samples: idx.iter().map(|&i| rec.samples[i]).collect(),
+                ..Default::default()
+            };
+            let n = idx.len();
+            (sub, (0..n).collect())
+        };
+        // The full parameter vector from the free ones.
+        let full = |th: &[f64]| -> Vec<f64> {
+            let mut t: Vec<f64> = spec.params.iter().map(|q| q.init).collect();
+            for (&i, v) in free.iter().zip(th) {
+                t[i] = *v;
+            }
+            t
+        };
+        let model_of = |theta: &[f64]| -> Result<Model> {
+            let tyre = apply(baseline, &spec, &full(theta))?;
+            let mut o = ro;
+            if o.kind == TransientKind::LuGre {
+                o.options.lugre = LuGreParams::from_tyre_params(tyre.params())?;
+            }
+            Ok(Model {
+                tyre,
+                base: baseline.clone(),
+                opts: o,
+                kappa_re: spec.kappa_re,
+                params: vec![],
+                at_bound: vec![],
+            })
+        };
+        let resid = |theta: &[f64]| -> Option<Vec<f64>> {
+            let m = model_of(theta).ok()?;
+            let sim = m.sim(&work).ok()?;
+            let mut out = Vec::with_capacity(3 * idx.len());
+            for (k, ch) in Channel::SCORED.iter().enumerate() {
+                if w[k] == 0.0 {
+                    continue;
+                }
+                let sw = w[k].sqrt();
+                let start = out.len();
+                for &i in &idx {
+                    let r = ch.measured(&work.samples[i]) - ch.of_forces(&sim[i]);
+                    out.push(if r.is_finite() { sw * r } else { 0.0 });
+                }
+                // Offsets are nuisance: centre each channel.
+                let n = (out.len() - start).max(1) as f64;
+                let mean = out[start..].iter().sum::<f64>() / n;
+                for x in &mut out[start..] {
+                    *x -= mean;
+                }
+            }
+            Some(out)
+        };
+        let mut params: Vec<Param> = free.iter().map(|&i| spec.params[i].clone()).collect();
+        let np = free.iter().filter(|&&i| i < spec.prescan).count();
+        if np > 0 {
+            let cost = |f: f64| {
+                let t: Vec<f64> = (0..params.len())
+                    .map(|i| params[i].init * if i < np { f } else { 1.0 })
+                    .collect();
+                resid(&t).map_or(f64::INFINITY, |r| r.iter().map(|x| x * x).sum())
+            };
+            let f = golden_log(0.1, 10.0, 14, cost);
+            for q in params.iter_mut().take(np) {
+                q.init *= f;
+            }
+        }
+        let theta = fit_lm(&params, resid);
+        let mut m = model_of(&theta)?;
+        m.params = params
+            .iter()
+            .zip(&theta)
+            .map(|(q, v)| (q.name.to_string(), *v))
+            .collect();
+        m.at_bound = params
+            .iter()
+            .zip(&theta)
+            .filter_map(|(q, &v)| {
+                // Within 0.1 % of the range of a bound (LM clamps onto it).
+                let tol = 1e-3 * (q.hi - q.lo).abs();
+                let which = if (v - q.lo).abs() <= tol {
+                    "lower"
+                } else if (q.hi - v).abs() <= tol {
+                    "upper"
+                } else {
+                    return None;
+                };
+                Some(format!("{} = {v:.4} (its {which} bound)", q.name))
+            })
+            .collect();
+        Ok(Box::new(m))
+    }
+}
+
+pub(super) fn key(k: &'static str) -> Target {
+    Target::Key(k)
+}
+
+pub(super) fn p(
+    name: &'static str,
+    targets: Vec<Target>,
+    init: f64,
+    lo: f64,
+    hi: f64,
+    h: f64,
+) -> Param {
+    Param {
+        name,
+        targets,
+        init,
+        lo,
+        hi,
+        h,
+        channels: ALL_CHANNELS,
+    }
+}
+
+/// A key of the file's table as its start value.
+pub(super) fn file(t: &Tyre, k: &str) -> f64 {
+    t.params().get(k).unwrap_or(0.0)
+}
+
+pub(super) fn is_mf6(t: &Tyre) -> bool {
+    matches!(t.version(), MfVersion::Mf61 | MfVersion::Mf62)
+}

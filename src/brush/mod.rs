@@ -34,6 +34,7 @@ mod contact;
 mod params;
 mod solver;
 pub mod study;
+pub(crate) mod transient;
 
 pub use carcass::StringCarcass;
 pub use contact::{half_length, pressure_shape, Point};

@@ -27,6 +27,9 @@ pub struct Args {
     /// MFeval use mode (hundreds limits 1 on/2 off, tens α* 1 off/2 on, units turn slip).
     #[arg(long, default_value_t = 111)]
     pub use_mode: u32,
+    /// Steady-state force model under the transient model: mf or brush.
+    #[arg(long, default_value = "mf")]
+    pub force_model: String,
 }
 
 /// Run the command.
@@ -45,11 +48,24 @@ pub fn run(a: Args) -> Result<()> {
     })?;
     let tyre = Tyre::from_file(&a.tir)?;
     let rec = crate::data::Recording::from_file(&a.recording)?;
-    let opts = ReplayOptions {
+    let brush = match crate::brush::ForceModelKind::parse(&a.force_model) {
+        Some(crate::brush::ForceModelKind::Mf) => None,
+        Some(crate::brush::ForceModelKind::Brush) => {
+            Some(crate::brush::BrushParams::from_tyre(&tyre)?.0)
+        }
+        None => {
+            return Err(Error::Input(format!(
+                "--force-model {}: expected mf or brush",
+                a.force_model
+            )))
+        }
+    };
+    let mut opts = ReplayOptions {
         kind,
         use_mode,
         ..Default::default()
     };
+    opts.options.brush = brush;
     let rp = replay(&rec, &tyre, &opts)?;
     let f = std::fs::File::create(&a.out).map_err(|e| Error::io(&a.out, e))?;
     write_csv(&rec, &rp, f).map_err(|e| Error::io(&a.out, e))?;

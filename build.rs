@@ -382,32 +382,70 @@ fn main() {
     }
 
     // GUID from the interface.
-    let mut canon = format!("fmi2|{model_identifier}\n");
-    for v in &vars {
-        let _ = writeln!(
-            canon,
-            "{}|{}|{}|{}|{}|{}|{}|{}",
-            v.name,
-            v.vr,
-            v.ty,
-            v.causality,
-            v.variability,
-            v.initial.as_deref().unwrap_or(""),
-            v.start.as_deref().unwrap_or(""),
-            v.unit.as_deref().unwrap_or("")
-        );
-    }
-    let h1 = fnv1a(canon.as_bytes(), 0xcbf2_9ce4_8422_2325);
-    let h2 = fnv1a(canon.as_bytes(), 0x84222325_cbf29ce4 ^ h1);
-    let guid = format!(
-        "{{{:08x}-{:04x}-{:04x}-{:04x}-{:012x}}}",
-        h1 >> 32,
-        (h1 >> 16) & 0xffff,
-        h1 & 0xffff,
-        h2 >> 48,
-        h2 & 0xffff_ffff_ffff
-    );
+    // A start value is part of the interface: a variant XML with another
+    // start value of a parameter (spec::START_VARIANTS, what `tyrekit package`
+    // may set) has its own GUID, which this binary also knows.
+    let guid_with = |over: Option<(&str, &str)>| {
+        let mut canon = format!("fmi2|{model_identifier}\n");
+        for v in &vars {
+            let start = match over {
+                Some((n, s)) if n == v.name => s,
+                _ => v.start.as_deref().unwrap_or(""),
+            };
+            let _ = writeln!(
+                canon,
+                "{}|{}|{}|{}|{}|{}|{}|{}",
+                v.name,
+                v.vr,
+                v.ty,
+                v.causality,
+                v.variability,
+                v.initial.as_deref().unwrap_or(""),
+                start,
+                v.unit.as_deref().unwrap_or("")
+            );
+        }
+        let h1 = fnv1a(canon.as_bytes(), 0xcbf2_9ce4_8422_2325);
+        let h2 = fnv1a(canon.as_bytes(), 0x84222325_cbf29ce4 ^ h1);
+        format!(
+            "{{{:08x}-{:04x}-{:04x}-{:04x}-{:012x}}}",
+            h1 >> 32,
+            (h1 >> 16) & 0xffff,
+            h1 & 0xffff,
+            h2 >> 48,
+            h2 & 0xffff_ffff_ffff
+        )
+    };
+    let guid = guid_with(None);
     let final_xml = text.replacen(GUID_PLACEHOLDER, &guid, 1);
+    let mut variants = Vec::new();
+    for (name, values) in spec::START_VARIANTS {
+        let v = vars
+            .iter()
+            .find(|v| v.name == *name)
+            .unwrap_or_else(|| fail(format!("spec::START_VARIANTS names {name}, not a variable")));
+        let at = text
+            .find(&format!("name=\"{name}\""))
+            .unwrap_or_else(|| fail(format!("{name}: not found in the XML text")));
+        let old = format!("start=\"{}\"", v.start.as_deref().unwrap_or(""));
+        let rel = text[at..]
+            .find(&old)
+            .unwrap_or_else(|| fail(format!("line {}: {name} has no start attribute", v.line)));
+        for value in values.iter() {
+            let mut x = text.clone();
+            x.replace_range(
+                at + rel..at + rel + old.len(),
+                &format!("start=\"{value}\""),
+            );
+            let g = guid_with(Some((name, value)));
+            variants.push((
+                name.to_string(),
+                value.to_string(),
+                g.clone(),
+                x.replacen(GUID_PLACEHOLDER, &g, 1),
+            ));
+        }
+    }
 
     // Generated Rust.
     let mut out = String::new();
@@ -433,6 +471,18 @@ fn main() {
         out,
         "pub const MODEL_DESCRIPTION_XML: &str = include_str!(concat!(env!(\"OUT_DIR\"), \"/modelDescription.xml\"));"
     );
+    let _ = writeln!(
+        out,
+        "/// Variants of the interface with another start value of a parameter\n/// (name, start value, GUID, modelDescription.xml): spec::START_VARIANTS."
+    );
+    let _ = writeln!(
+        out,
+        "pub const START_VARIANTS: &[(&str, &str, &str, &str)] = &["
+    );
+    for (n, v, g, x) in &variants {
+        let _ = writeln!(out, "    ({n:?}, {v:?}, {g:?}, {x:?}),");
+    }
+    let _ = writeln!(out, "];");
     let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
     let mut slots = Vec::new();
     for v in &vars {

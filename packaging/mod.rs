@@ -33,6 +33,23 @@ pub struct Options {
     pub out: Option<PathBuf>,
     /// Shared library to ship (default: [`find_library`]).
     pub library: Option<PathBuf>,
+    /// Default of the `force_model` parameter in the packaged XML (`mf` when
+    /// None): `brush` ships the interface variant with that start value
+    /// (its own GUID, which the library accepts: `vars::START_VARIANTS`).
+    pub force_model: Option<String>,
+}
+
+/// The modelDescription.xml to ship for a `force_model` default.
+pub fn model_description(force_model: Option<&str>) -> Result<&'static str> {
+    match force_model.map(|s| s.trim().to_ascii_lowercase()) {
+        None => Ok(MODEL_DESCRIPTION_XML),
+        Some(f) if f == "mf" => Ok(MODEL_DESCRIPTION_XML),
+        Some(f) => crate::fmi::vars::START_VARIANTS
+            .iter()
+            .find(|v| v.0 == "force_model" && v.1 == f)
+            .map(|v| v.3)
+            .ok_or_else(|| Error::Input(format!("--force-model {f}: expected mf or brush"))),
+    }
 }
 
 /// The crate root this binary was built from.
@@ -142,6 +159,7 @@ pub fn documentation(tyre_label: &str) -> String {
 /// Build the .fmu; returns its path.
 pub fn package(opts: &Options) -> Result<PathBuf> {
     let out = opts.out.clone().unwrap_or_else(default_fmu_path);
+    let xml = model_description(opts.force_model.as_deref())?;
     let (tir_text, label) = match &opts.tir {
         Some(p) => {
             // Refuse a file the FMU could not load at instantiation.
@@ -171,10 +189,7 @@ pub fn package(opts: &Options) -> Result<PathBuf> {
             .compression_method(zip::CompressionMethod::Deflated)
             .unix_permissions(0o644);
         let entries: [(String, &[u8]); 4] = [
-            (
-                "modelDescription.xml".into(),
-                MODEL_DESCRIPTION_XML.as_bytes(),
-            ),
+            ("modelDescription.xml".into(), xml.as_bytes()),
             (format!("binaries/linux64/{MODEL_IDENTIFIER}.so"), &so),
             ("resources/tyre.tir".into(), &tir_text),
             ("documentation/index.html".into(), doc.as_bytes()),

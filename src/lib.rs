@@ -10,6 +10,7 @@
 //! Conversions happen only at the edges (`.tir` `[UNITS]`, SAE/TTC recordings).
 
 pub mod bench;
+pub mod brush;
 pub mod cli;
 pub mod data;
 pub mod diagnose;

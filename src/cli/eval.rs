@@ -30,6 +30,10 @@ pub struct Args {
     /// units turn slip (1 off, 2 on).
     #[arg(long, default_value_t = 111)]
     pub use_mode: u32,
+    /// Force model: mf (the Magic Formula) or brush (`crate::brush`: Fx, Fy,
+    /// Mz from the brush, Mx = 0, the other columns from the MF).
+    #[arg(long, default_value = "mf")]
+    pub force_model: String,
 }
 
 /// Input column names, in `MfInput` order; `required` ones must be present.
@@ -167,5 +171,37 @@ pub fn run(args: Args) -> Result<()> {
     let inputs = read_inputs(&args.input)?;
     let mut out = vec![MfOutput::default(); inputs.len()];
     tyre.evaluate_batch(&inputs, mode, &mut out);
+    match crate::brush::ForceModelKind::parse(&args.force_model) {
+        Some(crate::brush::ForceModelKind::Mf) => {}
+        Some(crate::brush::ForceModelKind::Brush) => brush_columns(&tyre, &inputs, &mut out)?,
+        None => {
+            return Err(Error::Input(format!(
+                "--force-model {}: expected mf or brush",
+                args.force_model
+            )))
+        }
+    }
     write_outputs(&args.output, &out)
+}
+
+/// Replace Fx, Fy, Mx, Mz by the brush model's (parameters from the file's
+/// `[BRUSH]` section, MF-derived defaults), Kxκ/Kyα/μ by its own.
+fn brush_columns(tyre: &Tyre, inputs: &[MfInput], out: &mut [MfOutput]) -> Result<()> {
+    let (b, d) = crate::brush::BrushParams::from_tyre(tyre)?;
+    for n in &d.notes {
+        eprintln!("warning: {n}");
+    }
+    for (i, o) in inputs.iter().zip(out.iter_mut()) {
+        let f = b.forces(&crate::brush::BrushInput::new(i.fz, i.kappa, i.alpha.tan()));
+        o.fx = f.fx;
+        o.fy = f.fy;
+        o.mx = 0.0;
+        o.mz = if i.vx < 0.0 { -f.mz } else { f.mz };
+        let fz = i.fz.max(0.0);
+        o.kxk = b.slip_stiffness(fz);
+        o.kya = -b.cornering_stiffness(fz);
+        o.mux = f.mu_k;
+        o.muy = f.mu_k;
+    }
+    Ok(())
 }

@@ -16,6 +16,9 @@ pub struct Args {
     /// Shared library to ship (default: target/release/libtyrekit.so, built if missing or stale).
     #[arg(long, value_name = "SO")]
     pub library: Option<PathBuf>,
+    /// Default of the FMU's `force_model` parameter: mf (Magic Formula) or brush.
+    #[arg(long, value_name = "MODEL")]
+    pub force_model: Option<String>,
 }
 
 /// Run the command.
@@ -24,6 +27,7 @@ pub fn run(args: Args) -> crate::Result<()> {
         tir: args.tir,
         out: args.out,
         library: args.library,
+        force_model: args.force_model,
     })?;
     println!("{}", path.display());
     Ok(())

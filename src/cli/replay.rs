@@ -30,6 +30,9 @@ pub struct Args {
     /// How to read the recording (`--re model` uses --tir's Re(Fz)).
     #[command(flatten)]
     pub read: crate::cli::data::RecordingArgs,
+    /// Steady-state force model under the transient model: mf or brush.
+    #[arg(long, default_value = "mf")]
+    pub force_model: String,
 }
 
 /// Run the command.
@@ -47,13 +50,26 @@ pub fn run(a: Args) -> Result<()> {
     let rec = crate::cli::data::load_all(std::slice::from_ref(&a.recording), &load, "replay")?
         .remove(0)
         .recording;
+    let brush = match crate::brush::ForceModelKind::parse(&a.force_model) {
+        Some(crate::brush::ForceModelKind::Mf) => None,
+        Some(crate::brush::ForceModelKind::Brush) => {
+            Some(crate::brush::BrushParams::from_tyre(&tyre)?.0)
+        }
+        None => {
+            return Err(Error::Input(format!(
+                "--force-model {}: expected mf or brush",
+                a.force_model
+            )))
+        }
+    };
     // As the FMU runs by default: κ from the wheel speed where recorded.
-    let opts = ReplayOptions {
+    let mut opts = ReplayOptions {
         kind,
         use_mode,
         wheel_speed: true,
         ..Default::default()
     };
+    opts.options.brush = brush;
     let mode = crate::residual::input_mode(&rec, &opts);
     let rp = replay(&rec, &tyre, &opts)?;
     let f = std::fs::File::create(&a.out).map_err(|e| Error::io(&a.out, e))?;

@@ -194,7 +194,12 @@ pub unsafe extern "C" fn fmi2Instantiate(
             Ok(g) => g,
             Err(e) => return fail(&log, e),
         };
-        if g != vars::GUID {
+        // The default interface, or a start-value variant `tyrekit package` wrote.
+        let variant = vars::START_VARIANTS
+            .iter()
+            .find(|v| v.2 == g)
+            .map(|v| (v.0, v.1));
+        if g != vars::GUID && variant.is_none() {
             return fail(
                 &log,
                 format!(
@@ -211,7 +216,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
                 Err(_) => return fail(&log, "fmuResourceLocation is not valid UTF-8".into()),
             }
         };
-        match Instance::new(log, loc) {
+        match Instance::new_variant(log, loc, variant) {
             Ok(inst) => Box::into_raw(inst) as fmi2Component,
             Err((log, msg)) => fail(&log, msg),
         }

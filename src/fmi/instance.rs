@@ -29,6 +29,7 @@ use super::types::Fmi2Status;
 use super::vars::{
     self, boolean, integer, real, string, Causality, Values, VarInfo, VarType, Variability,
 };
+use crate::brush::{BrushParams, ForceModelKind};
 use crate::mf::{Tyre, UseMode};
 use crate::tir::TyreSide;
 use crate::transient::{
@@ -149,7 +150,13 @@ pub struct Instance {
     /// resources/tyre.tir, loaded at instantiation (what fmi2Reset returns to).
     pub default_tyre: Loaded,
     pub sim: Sim,
+    /// The start-value variant of the interface the master instantiated
+    /// (its GUID named it; `vars::START_VARIANTS`), None for the default XML.
+    pub variant: Option<StartVariant>,
 }
+
+/// A parameter's start value differing from the default XML: (name, value).
+pub type StartVariant = (&'static str, &'static str);
 
 /// The settings derived from the parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -207,6 +214,20 @@ pub fn derive(values: &Values, tyre: &Tyre) -> Result<Derived, String> {
     };
     let lugre = LuGreParams::from_tyre_params(tyre.params())
         .map_err(|e| format!("transient = \"{kind_s}\": [LUGRE] section: {e}"))?;
+    let force_s = values.string(string::FORCE_MODEL);
+    let brush = match ForceModelKind::parse(force_s) {
+        Some(ForceModelKind::Mf) => None,
+        Some(ForceModelKind::Brush) => Some(
+            BrushParams::from_tyre(tyre)
+                .map_err(|e| format!("force_model = \"brush\": [BRUSH] section: {e}"))?
+                .0,
+        ),
+        None => {
+            return Err(format!(
+                "force_model = \"{force_s}\": expected \"mf\" or \"brush\""
+            ))
+        }
+    };
     Ok(Derived {
         config: TransientConfig {
             kind,
@@ -216,6 +237,7 @@ pub fn derive(values: &Values, tyre: &Tyre) -> Result<Derived, String> {
         options: TransientOptions {
             nonlinear: values.booleans[boolean::NONLINEAR],
             lugre,
+            brush,
         },
         mirror,
     })
@@ -269,8 +291,14 @@ fn input_problem(slot: usize, x: f64) -> Option<&'static str> {
 
 impl Sim {
     /// The state right after instantiation / reset.
-    fn initial(loaded: Loaded) -> Result<Sim, String> {
-        let values = Values::start();
+    fn initial(loaded: Loaded, variant: Option<StartVariant>) -> Result<Sim, String> {
+        let mut values = Values::start();
+        if let Some((name, value)) = variant {
+            // build.rs only generates variants of String parameters it knows.
+            if let Some(v) = super::vars::by_name(name) {
+                values.strings[v.slot] = std::ffi::CString::new(value).unwrap_or_default();
+            }
+        }
         let d = derive(&values, &loaded.tyre)?;
         let mut sim = Sim {
             phase: Phase::Instantiated,
@@ -531,6 +559,15 @@ impl Instance {
         log: Logger,
         resource_location: Option<&str>,
     ) -> Result<Box<Instance>, (Logger, String)> {
+        Instance::new_variant(log, resource_location, None)
+    }
+
+    /// [`Instance::new`] for a start-value variant of the interface.
+    pub fn new_variant(
+        log: Logger,
+        resource_location: Option<&str>,
+        variant: Option<StartVariant>,
+    ) -> Result<Box<Instance>, (Logger, String)> {
         let Some(loc) = resource_location else {
             return Err((
                 log,
@@ -554,7 +591,7 @@ impl Instance {
             Ok(t) => t,
             Err(e) => return Err((log, e)),
         };
-        let sim = match Sim::initial(default_tyre.clone()) {
+        let sim = match Sim::initial(default_tyre.clone(), variant) {
             Ok(s) => s,
             Err(e) => return Err((log, e)),
         };
@@ -564,6 +601,7 @@ impl Instance {
             resources,
             default_tyre,
             sim,
+            variant,
         });
         for w in &inst.default_tyre.tyre.params().warnings {
             inst.log.status(Fmi2Status::Warning, w);
@@ -584,7 +622,7 @@ impl Instance {
 
     /// fmi2Reset: back to the state right after fmi2Instantiate.
     pub fn reset(&mut self) -> Result<(), String> {
-        self.sim = Sim::initial(self.default_tyre.clone())?;
+        self.sim = Sim::initial(self.default_tyre.clone(), self.variant)?;
         self.event("reset to the instantiated state");
         Ok(())
     }

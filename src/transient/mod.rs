@@ -223,6 +223,11 @@ pub struct TransientOptions {
     pub nonlinear: bool,
     /// LuGre parameters (default: friction function derived from the Magic Formula).
     pub lugre: LuGreParams,
+    /// The steady-state force model: `None` = the Magic Formula; `Some` = the
+    /// brush model (`crate::brush`), whose forces every transient model then
+    /// uses, with the relaxation lengths and stiffnesses of the brush
+    /// (`crate::brush::transient`). The MF still gives Re and My.
+    pub brush: Option<crate::brush::BrushParams>,
 }
 
 /// A tyre's dynamics: configuration plus state. One per FMU instance / replay.
@@ -693,6 +698,8 @@ pub(crate) struct StepCtx<'a> {
     /// −1 reversing from velocities, else +1: maps the transient models'
     /// κ = −Vsx/|Vx| to the MF's κ = −Vsx/Vx (see [`StepCtx::forces`]).
     pub dir: f64,
+    /// The brush force model, when chosen ([`TransientOptions::brush`]).
+    pub brush: Option<&'a crate::brush::BrushParams>,
 }
 
 impl StepCtx<'_> {
@@ -709,6 +716,9 @@ impl StepCtx<'_> {
     /// actual speed).
     #[inline]
     pub fn forces(&self, base: &MfInput, sl: Slip) -> Forces {
+        if let Some(b) = self.brush {
+            return crate::brush::transient::forces(b, self.fz, self.stiff(sl), self.s, base.vx);
+        }
         let sl = Slip {
             kappa: self.dir * sl.kappa,
             ..sl
@@ -727,6 +737,10 @@ impl StepCtx<'_> {
     /// Fx, Fy of [`StepCtx::forces`] only (bit-identical), without the moments.
     #[inline]
     pub fn forces_xy(&self, base: &MfInput, sl: Slip) -> (f64, f64) {
+        if self.brush.is_some() {
+            let f = self.forces(base, sl);
+            return (f.fx, f.fy);
+        }
         let sl = Slip {
             kappa: self.dir * sl.kappa,
             ..sl
@@ -834,7 +848,8 @@ impl TransientModel {
         // probe only Re (for the slips): its force evaluation gives μ, Kxκ,
         // Kyα, C and σ too, bit-identical to the probe's
         // ([`Tyre::forces_and_props`]), so the probe's Magic Formula is skipped.
-        let fast = steady && !mode.turn_slip && fz > FZ_OFF;
+        let brush = self.options.brush.as_ref();
+        let fast = steady && !mode.turn_slip && fz > FZ_OFF && brush.is_none();
         let (mut probe, mut props, terms) = if fast {
             let probe = SlipProps {
                 re: tyre.zero_slip_radius(&base, mode),
@@ -846,8 +861,12 @@ impl TransientModel {
             };
             (probe, props, None)
         } else {
-            let (probe, terms) = tyre.slip_properties_terms(&base, mode, 1.0, want_forces, !steady);
-            let props = tyre_props(tyre, &probe, fz, inp.vx.abs());
+            let my = !steady || brush.is_some();
+            let (probe, terms) = tyre.slip_properties_terms(&base, mode, 1.0, want_forces, my);
+            let mut props = tyre_props(tyre, &probe, fz, inp.vx.abs());
+            if let Some(b) = brush {
+                crate::brush::transient::step_props(b, &mut props, fz);
+            }
             (probe, props, Some(terms))
         };
         let kin = kinematics(self.config.input_mode, inp, props.re);
@@ -893,6 +912,7 @@ impl TransientModel {
             floored,
             dir,
             terms,
+            brush,
         };
         let mut next = self.state;
         let mut out = if fz <= FZ_OFF {
@@ -913,9 +933,12 @@ impl TransientModel {
                 ..Default::default()
             }
         } else if steady {
-            let f = match solved {
-                Some(f) => f,
-                None => mf_at(tyre, &fbase, mode, ctx.stiff(steady_slip), s),
+            let f = match (solved, brush) {
+                (Some(f), _) => f,
+                // The brush's κ is −Vsx/|Vx| (its force opposes the slip speed
+                // whichever way the wheel rolls).
+                (None, Some(_)) => ctx.forces(&fbase, Slip::of(&kin)),
+                (None, None) => mf_at(tyre, &fbase, mode, ctx.stiff(steady_slip), s),
             };
             self.output(&ctx, &f, steady_slip)
         } else {
@@ -948,7 +971,7 @@ impl TransientModel {
         if let Some(e) = ext {
             e.advance(&self.state, &mut next, &out, dt);
         }
-        if !steady && fz > FZ_OFF {
+        if (!steady || brush.is_some()) && fz > FZ_OFF {
             // Rolling resistance at the actual speed and direction (the MF's
             // own low-speed treatment), from the zero-slip probe.
             out.my = probe.my;

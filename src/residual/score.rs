@@ -175,13 +175,13 @@ pub fn noise_floor(rec: &Recording, ch: Channel, mask: &[bool]) -> f64 {
         cnt[i + 1] = cnt[i] + usize::from(ok);
     }
     let (mut ss, mut m) = (0.0, 0usize);
-    for i in k..n.saturating_sub(k) {
+    for (i, x) in s.iter().enumerate().take(n.saturating_sub(k)).skip(k) {
         let (lo, hi) = (i - k, i + k + 1);
         // A full window of masked finite samples only.
         if cnt[hi] - cnt[lo] != 2 * k + 1 {
             continue;
         }
-        let d = ch.measured(&s[i]) - (sum[hi] - sum[lo]) / w;
+        let d = ch.measured(x) - (sum[hi] - sum[lo]) / w;
         ss += d * d;
         m += 1;
     }

@@ -43,9 +43,17 @@ pub fn run(a: Args) -> Result<()> {
             a.use_mode
         ))
     })?;
+    let from_file = a.transient.trim().eq_ignore_ascii_case(TransientKind::FROM_FILE);
+    if !from_file && TransientKind::parse(&a.transient).is_none() {
+        return Err(Error::Input(format!(
+            "--transient {}: expected file (as the tyre file says), steady, relaxation or lugre",
+            a.transient
+        )));
+    }
     let tyre = Tyre::from_file(&a.tir)?;
-    let kind = TransientKind::resolve(&a.transient, tyre.params())
-        .map_err(|e| Error::Input(format!("--transient: {e}")))?;
+    // "file": the tyre file's [TYREKIT] TRANSIENT (a bad value there is
+    // an error naming the file and key), steady without one.
+    let kind = TransientKind::resolve(&a.transient, tyre.params())?;
     let load = a.read.options(Some(&tyre), "--tir")?;
     let rec = crate::cli::data::load_all(std::slice::from_ref(&a.recording), &load, "replay")?
         .remove(0)

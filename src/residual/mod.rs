@@ -19,6 +19,6 @@ pub use channel::Channel;
 pub use input::{has_core_inputs, mf_input, wheel_input};
 pub use replay::{input_mode, median_spacing, replay, write_csv, Replay, ReplayOptions};
 pub use score::{
-    channel_nrmse, channel_sse, inverse_variances, nrmse_per_channel, offsets, sse, weighted_sse,
-    PerChannel, FX, FY, MZ,
+    channel_nrmse, channel_sse, inverse_variances, noise_floor, nrmse_per_channel, offsets, sse,
+    weighted_sse, PerChannel, FX, FY, MZ, NOISE_WINDOW,
 };

@@ -1,0 +1,294 @@
+//! The diagnosis measured on the independent dev set
+//! (`../shared/data/diagnose-dev`, issue #15 acceptance), as a user runs it:
+//! `tyrekit diagnose REC --report DIR` (no `--tir`), then
+//! `tyrekit replay REC --tir DIR/baseline.tir --out sim.csv` and the same
+//! for `DIR/extended.tir`, no other flags. Per recording: the verdict
+//! against `answers.json`'s effect, and for a right name the share of the
+//! gap recovered — (NRMSE baseline.tir − NRMSE extended.tir) / (answer
+//! baseline − answer truth) on the channel with the largest pure-slip
+//! `baseline − truth`, its pure-slip rows of the last 30 % (the row groups
+//! of the shared harness `common/devset.rs`, found from the signals alone).
+//!
+//! Beside it, the same two files replayed through the library with the
+//! recorded slips prescribed (`ReplayOptions::wheel_speed` off, the file's
+//! transient model): `replay` takes κ from the wheel speed and the tyre's
+//! Re(Fz) as the FMU does, so a baseline whose Re(Fz) is not the rig's
+//! replays worse there than the diagnosis scored it.
+//!
+//! Run: `cargo test --release --test diagnose_devset -- --nocapture` (21
+//! diagnoses, two at a time); the issue's figures:
+//! `-- --ignored --nocapture`. Skips with a message without `../shared`.
+
+#[path = "common/mod.rs"]
+mod common;
+#[path = "common/devset.rs"]
+mod devset;
+
+use devset::Answer;
+use std::path::Path;
+use std::process::Command;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Mutex, OnceLock};
+use tyrekit::mf::Tyre;
+use tyrekit::residual::{write_csv, ReplayOptions};
+use tyrekit::transient::TransientKind;
+
+/// Issue #15's acceptance: effects named first, controls `none`, median gap.
+const NAMED_MIN: usize = 17;
+const CONTROLS_MIN: usize = 3;
+const GAP_MEDIAN_MIN: f64 = 0.5;
+/// Before this work (issue #15's text): 5 of 18 named, 2 of 3 controls.
+const NAMED_BEFORE: usize = 5;
+const CONTROLS_BEFORE: usize = 2;
+
+struct Outcome {
+    name: String,
+    effect: String,
+    verdict: String,
+    /// Gap channel ("FY"), recovered share (NaN when not computable).
+    channel: String,
+    recovered: f64,
+    /// NRMSE of baseline.tir and extended.tir on the gap rows.
+    nrmse: (f64, f64),
+    /// The answer's baseline and truth on the gap rows.
+    answer: (f64, f64),
+    /// NRMSE of both files and the recovered share with slips prescribed.
+    slips: (f64, f64, f64),
+    seconds: f64,
+}
+
+/// (effect, gap channel, answer baseline, answer truth) of a recording.
+fn truth(dir: &Path, name: &str) -> (String, String, f64, f64) {
+    let text = std::fs::read_to_string(dir.join("answers.json")).expect("answers.json");
+    let v: serde_json::Value = serde_json::from_str(&text).expect("JSON");
+    let a = &v["recordings"][name];
+    let effect = a["effect"].as_str().expect("effect").to_string();
+    let pure = a["nrmse_last30"]["pure"].as_object().expect("pure group");
+    let (ch, b, t) = pure
+        .iter()
+        .map(|(c, f)| {
+            (
+                c.clone(),
+                f["baseline"].as_f64().expect("baseline"),
+                f["truth"].as_f64().expect("truth"),
+            )
+        })
+        .max_by(|x, y| (x.1 - x.2).total_cmp(&(y.1 - y.2)))
+        .expect("a pure-slip channel");
+    (effect, ch, b, t)
+}
+
+fn replay(exe: &str, rec: &Path, tir: &Path, out: &Path) {
+    let o = Command::new(exe)
+        .arg("replay")
+        .arg(rec)
+        .arg("--tir")
+        .arg(tir)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .expect("run tyrekit replay");
+    assert!(
+        o.status.success(),
+        "tyrekit replay {} failed: {}",
+        tir.display(),
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+fn run(a: &Answer, dir: &Path, data: &Path) -> Outcome {
+    let exe = env!("CARGO_BIN_EXE_tyrekit");
+    let report = dir.join(&a.name);
+    let t0 = std::time::Instant::now();
+    let o = Command::new(exe)
+        .arg("diagnose")
+        .arg(&a.file)
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .expect("run tyrekit diagnose");
+    assert!(
+        o.status.success(),
+        "{}: tyrekit diagnose failed: {}",
+        a.name,
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let seconds = t0.elapsed().as_secs_f64();
+    let j: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(report.join("diagnosis.json")).expect("diagnosis.json"),
+    )
+    .expect("diagnosis.json is JSON");
+    let verdict = j["verdict"].as_str().expect("verdict").to_string();
+    let (effect, channel, ab, at) = truth(data, &a.name);
+    let raw = devset::read_raw(&a.file);
+    let gap_nrmse = |sim: &Path| {
+        let (figs, _) = devset::figures(a, &raw, &devset::read_sim(sim));
+        figs.iter()
+            .find(|x| x.group == "pure" && x.channel == channel)
+            .map_or(f64::NAN, |x| x.ours)
+    };
+    let rec = tyrekit::data::Recording::from_file(&a.file).expect("recording");
+    let mut nr = [f64::NAN; 2];
+    let mut ns = [f64::NAN; 2];
+    for (k, f) in ["baseline", "extended"].iter().enumerate() {
+        let tir = report.join(format!("{f}.tir"));
+        let sim = report.join(format!("{f}_sim.csv"));
+        replay(exe, &a.file, &tir, &sim);
+        nr[k] = gap_nrmse(&sim);
+        let tyre = Tyre::from_file(&tir).expect("tyre file");
+        let opts = ReplayOptions {
+            kind: TransientKind::resolve(TransientKind::FROM_FILE, tyre.params()).expect("kind"),
+            ..Default::default()
+        };
+        let rp = tyrekit::residual::replay(&rec, &tyre, &opts).expect("replay");
+        let sim = report.join(format!("{f}_slips.csv"));
+        write_csv(&rec, &rp, std::fs::File::create(&sim).expect("csv")).expect("write");
+        ns[k] = gap_nrmse(&sim);
+    }
+    Outcome {
+        name: a.name.clone(),
+        effect,
+        verdict,
+        channel,
+        recovered: (nr[0] - nr[1]) / (ab - at),
+        nrmse: (nr[0], nr[1]),
+        answer: (ab, at),
+        slips: (ns[0], ns[1], (ns[0] - ns[1]) / (ab - at)),
+        seconds,
+    }
+}
+
+fn outcomes() -> Option<&'static Vec<Outcome>> {
+    static CELL: OnceLock<Option<Vec<Outcome>>> = OnceLock::new();
+    CELL.get_or_init(|| {
+        let dir = common::shared().join("data/diagnose-dev");
+        let Some(answers) = devset::answers(&dir) else {
+            eprintln!(
+                "SKIP diagnose_devset: {} not found (the shared dev set)",
+                dir.display()
+            );
+            return None;
+        };
+        let work = Path::new(env!("CARGO_TARGET_TMPDIR")).join("diagnose_devset");
+        std::fs::create_dir_all(&work).expect("work dir");
+        let next = AtomicUsize::new(0);
+        let done = Mutex::new(Vec::new());
+        std::thread::scope(|s| {
+            for _ in 0..2 {
+                s.spawn(|| loop {
+                    let i = next.fetch_add(1, Ordering::SeqCst);
+                    let Some(a) = answers.get(i) else { break };
+                    let o = run(a, &work, &dir);
+                    done.lock().unwrap().push(o);
+                });
+            }
+        });
+        let mut v: Vec<Outcome> = done.into_inner().unwrap();
+        v.sort_by(|a, b| a.name.cmp(&b.name));
+        print_table(&v);
+        Some(v)
+    })
+    .as_ref()
+}
+
+/// (named right, effects, controls none, controls, median recovered over the named).
+fn summary(v: &[Outcome]) -> (usize, usize, usize, usize, f64) {
+    let effects: Vec<&Outcome> = v.iter().filter(|o| o.effect != "none").collect();
+    let controls: Vec<&Outcome> = v.iter().filter(|o| o.effect == "none").collect();
+    let named: Vec<&&Outcome> = effects.iter().filter(|o| o.verdict == o.effect).collect();
+    let mut gaps: Vec<f64> = named
+        .iter()
+        .map(|o| o.recovered)
+        .filter(|g| g.is_finite())
+        .collect();
+    gaps.sort_by(f64::total_cmp);
+    let median = if gaps.is_empty() {
+        f64::NAN
+    } else if gaps.len() % 2 == 1 {
+        gaps[gaps.len() / 2]
+    } else {
+        0.5 * (gaps[gaps.len() / 2 - 1] + gaps[gaps.len() / 2])
+    };
+    (
+        named.len(),
+        effects.len(),
+        controls.iter().filter(|o| o.verdict == "none").count(),
+        controls.len(),
+        median,
+    )
+}
+
+fn print_table(v: &[Outcome]) {
+    println!(
+        "{:<4} {:<17} {:<17} {:<3} {:>9} {:>9} {:>9} {:>9} {:>8} | {:>9} {:>9} {:>8} {:>4}",
+        "rec",
+        "effect",
+        "verdict",
+        "ch",
+        "base.tir",
+        "ext.tir",
+        "ans.base",
+        "ans.trth",
+        "gap %",
+        "base.slp",
+        "ext.slp",
+        "gap.slp%",
+        "s"
+    );
+    for o in v {
+        println!(
+            "{:<4} {:<17} {:<17} {:<3} {:>9.5} {:>9.5} {:>9.5} {:>9.5} {:>8.1} | {:>9.5} {:>9.5} {:>8.1} {:>4.0}{}",
+            o.name,
+            o.effect,
+            o.verdict,
+            o.channel,
+            o.nrmse.0,
+            o.nrmse.1,
+            o.answer.0,
+            o.answer.1,
+            100.0 * o.recovered,
+            o.slips.0,
+            o.slips.1,
+            100.0 * o.slips.2,
+            o.seconds,
+            if o.verdict == o.effect { "  ok" } else { "" }
+        );
+    }
+    let (n, ne, c, nc, m) = summary(v);
+    let mut gs: Vec<f64> = v
+        .iter()
+        .filter(|o| o.effect != "none" && o.verdict == o.effect && o.slips.2.is_finite())
+        .map(|o| o.slips.2)
+        .collect();
+    gs.sort_by(f64::total_cmp);
+    let ms = gs.get(gs.len() / 2).copied().unwrap_or(f64::NAN);
+    println!(
+        "named first {n}/{ne}, controls none {c}/{nc}; median gap recovered over the named {:.0} % (replay as the FMU: kappa from wheel speed), {:.0} % with slips prescribed",
+        100.0 * m,
+        100.0 * ms
+    );
+}
+
+/// Live: no regression from the state the issue reports (5/18 named, 2/3
+/// controls `none`).
+#[test]
+fn devset_diagnosis_does_not_regress() {
+    let Some(v) = outcomes() else { return };
+    let (n, _, c, _, _) = summary(v);
+    assert!(n >= NAMED_BEFORE, "named first {n}, before {NAMED_BEFORE}");
+    assert!(
+        c >= CONTROLS_BEFORE,
+        "controls none {c}, before {CONTROLS_BEFORE}"
+    );
+}
+
+/// The issue's acceptance figures.
+#[test]
+#[ignore = "issue #15's figures (>= 17/18 named, 3/3 controls, median gap >= 50 %) are not met yet: see the README's dev-set table"]
+fn devset_diagnosis_meets_the_issue_figures() {
+    let Some(v) = outcomes() else { return };
+    let (n, _, c, _, m) = summary(v);
+    assert!(n >= NAMED_MIN, "named first {n} < {NAMED_MIN}");
+    assert!(c >= CONTROLS_MIN, "controls none {c} < {CONTROLS_MIN}");
+    assert!(m >= GAP_MEDIAN_MIN, "median gap {m:.2} < {GAP_MEDIAN_MIN}");
+}

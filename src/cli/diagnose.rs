@@ -65,7 +65,7 @@ pub fn run(a: Args) -> Result<()> {
             )));
         }
     }
-    let given = a.tir.as_ref().map(|t| Tyre::from_file(t)).transpose()?;
+    let given = a.tir.as_ref().map(|t| super::load_tyre(t)).transpose()?;
     let re = match (a.re.as_deref(), &given) {
         (None | Some("model"), Some(t)) => ReChoice::Model(Box::new(t.clone())),
         (None, None) => ReChoice::FreeRolling,

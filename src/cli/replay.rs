@@ -5,7 +5,7 @@
 //! Must never: panic on a bad file or flag (errors name the file and flag).
 
 use crate::diagnose::replay::{replay, write_csv, ReplayOptions};
-use crate::mf::{Tyre, UseMode};
+use crate::mf::UseMode;
 use crate::transient::TransientKind;
 use crate::{Error, Result};
 use std::path::PathBuf;
@@ -43,7 +43,7 @@ pub fn run(a: Args) -> Result<()> {
             a.use_mode
         ))
     })?;
-    let tyre = Tyre::from_file(&a.tir)?;
+    let tyre = super::load_tyre(&a.tir)?;
     let rec = crate::data::Recording::from_file(&a.recording)?;
     let opts = ReplayOptions {
         kind,

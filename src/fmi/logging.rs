@@ -145,11 +145,14 @@ impl Logger {
                 }
             }
         }
+        if on {
+            // FMI 2.0 §2.1.5: with loggingOn and a category list, only the
+            // listed categories are logged.
+            self.enabled = [false; 5];
+            self.debug = true;
+        }
         for i in idx {
             self.enabled[i] = on;
-        }
-        if on {
-            self.debug = true;
         }
         Ok(())
     }

@@ -35,6 +35,9 @@ struct Var {
     initial: Option<String>,
     start: Option<String>,
     unit: Option<String>,
+    /// `min`/`max` of a Real (±inf when absent): the FMU refuses inputs outside.
+    min: f64,
+    max: f64,
     description: String,
     line: u32,
 }
@@ -275,6 +278,14 @@ fn main() {
             initial,
             start,
             unit,
+            min: te
+                .attribute("min")
+                .and_then(|b| b.trim().parse::<f64>().ok())
+                .unwrap_or(f64::NEG_INFINITY),
+            max: te
+                .attribute("max")
+                .and_then(|b| b.trim().parse::<f64>().ok())
+                .unwrap_or(f64::INFINITY),
             description: sv.attribute("description").unwrap_or("").to_string(),
             line,
         });
@@ -541,6 +552,15 @@ fn main() {
             (Some(x), "Boolean") => format!("Start::Boolean({})", matches!(x.trim(), "true" | "1")),
             (Some(x), _) => format!("Start::String({x:?})"),
         };
+        let bound = |x: f64| {
+            if x == f64::INFINITY {
+                "f64::INFINITY".to_string()
+            } else if x == f64::NEG_INFINITY {
+                "f64::NEG_INFINITY".to_string()
+            } else {
+                format!("{x:?}")
+            }
+        };
         let cap = |s: &str| {
             let mut c = s.chars();
             c.next()
@@ -549,13 +569,15 @@ fn main() {
         };
         let _ = writeln!(
             out,
-            "    VarInfo {{ vr: {}, name: {:?}, ty: VarType::{}, slot: {s}, causality: Causality::{}, variability: Variability::{}, start: {start}, unit: {:?}, description: {:?} }},",
+            "    VarInfo {{ vr: {}, name: {:?}, ty: VarType::{}, slot: {s}, causality: Causality::{}, variability: Variability::{}, start: {start}, unit: {:?}, min: {}, max: {}, description: {:?} }},",
             v.vr,
             v.name,
             v.ty,
             cap(&v.causality),
             cap(&v.variability),
             v.unit.as_deref().unwrap_or(""),
+            bound(v.min),
+            bound(v.max),
             v.description
         );
     }

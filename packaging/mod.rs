@@ -163,9 +163,13 @@ pub fn package(opts: &Options) -> Result<PathBuf> {
     let (tir_text, label) = match &opts.tir {
         Some(p) => {
             // Refuse a file the FMU could not load at instantiation.
-            let params = TyreParams::from_file(p)?;
-            let bytes = std::fs::read(p).map_err(|e| Error::io(p, e))?;
-            (bytes, format!("{} ({:?})", p.display(), params.version))
+            // (the same reader and validation as fmi2Instantiate; doubts shown).
+            let tyre = crate::mf::Tyre::from_file(p)?;
+            for w in tyre.warnings() {
+                eprintln!("tyrekit: warning: {}: {w}", p.display());
+            }
+            let bytes = crate::tir::read_file(p)?;
+            (bytes, format!("{} ({:?})", p.display(), tyre.version()))
         }
         None => (
             TyreParams::builtin().to_tir_string().into_bytes(),

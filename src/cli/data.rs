@@ -96,7 +96,7 @@ impl ReadArgs {
         let tyre = self
             .tir
             .as_ref()
-            .map(|t| crate::mf::Tyre::from_file(t))
+            .map(|t| super::load_tyre(t))
             .transpose()?;
         let mut o = self.rec.options(tyre.as_ref(), "--tir")?;
         if self.compute_kappa {
@@ -236,6 +236,16 @@ fn fmt_range(lo: f64, hi: f64, scale: f64, prec: usize) -> String {
     format!("{:.p$} … {:.p$}", lo * scale, hi * scale, p = prec)
 }
 
+/// A number with `prec` decimals, or "-" when the channel is missing (never
+/// "NaN" in the summary).
+fn num(x: f64, prec: usize) -> String {
+    if x.is_finite() {
+        format!("{x:.prec$}")
+    } else {
+        "-".into()
+    }
+}
+
 fn minmax(v: impl Iterator<Item = f64>) -> (f64, f64) {
     v.filter(|x| x.is_finite())
         .fold((f64::NAN, f64::NAN), |(a, b), x| (a.min(x), b.max(x)))
@@ -327,13 +337,13 @@ pub fn summary_text(l: &Loaded) -> String {
         let (k0, k1) = minmax(seg.iter().map(|x| x.kappa));
         let _ = writeln!(
             s,
-            "{:>4} {:<13} {:>9.0} {:>7.2} {:>8.1} {:>7.1} {:>7} {:>8} {:>8.1} {:>19} {:>17}",
+            "{:>4} {:<13} {:>9} {:>7} {:>8} {:>7} {:>7} {:>8} {:>8.1} {:>19} {:>17}",
             i,
             g.kind.label(),
-            g.fz,
-            g.gamma.to_degrees(),
-            g.p / 1e3,
-            g.vx * 3.6,
+            num(g.fz, 0),
+            num(g.gamma.to_degrees(), 2),
+            num(g.p / 1e3, 1),
+            num(g.vx * 3.6, 1),
             if g.alpha.is_finite() {
                 format!("{:.2}", g.alpha.to_degrees())
             } else {

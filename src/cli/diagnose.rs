@@ -64,7 +64,7 @@ pub fn run(a: Args) -> Result<()> {
             )));
         }
     }
-    let given = a.tir.as_ref().map(|t| Tyre::from_file(t)).transpose()?;
+    let given = a.tir.as_ref().map(|t| super::load_tyre(t)).transpose()?;
     let mut opts = a.read.options(given.as_ref(), "--tir")?;
     if a.read.re.is_none() {
         opts.re = match &given {

@@ -165,7 +165,7 @@ pub fn run(args: Args) -> Result<()> {
         ))
     })?;
     let tyre = match &args.tir {
-        Some(p) => Tyre::from_file(p)?,
+        Some(p) => super::load_tyre(p)?,
         None => Tyre::builtin(),
     };
     let inputs = read_inputs(&args.input)?;

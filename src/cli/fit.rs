@@ -92,7 +92,9 @@ pub fn run(args: Args) -> Result<()> {
     let mut start = match &args.start {
         Some(p) => {
             opts.nominal_from_data = false;
-            TyreParams::from_file(p)?
+            let t = TyreParams::from_file(p)?;
+            super::show_warnings(&p.display().to_string(), &t.warnings);
+            t
         }
         None => TyreParams::builtin(),
     };
@@ -131,6 +133,12 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
+    // The fitted tyre passes the same validation as any loaded one before
+    // it is written (a refusal is an error; doubts are shown).
+    let checked = Tyre::checked(res.tyre.clone())?;
+    let n_read = res.tyre.warnings.len();
+    super::show_warnings(&args.out.display().to_string(), &checked.warnings()[n_read..]);
+    res.tyre.write(&args.out)?;
     for s in &res.skipped {
         eprintln!("tyrekit fit: stage skipped: {s}");
     }

@@ -45,6 +45,22 @@ pub enum Command {
     Diagnose(diagnose::Args),
 }
 
+/// Load a `.tir` for a command: [`Tyre::from_file`](crate::mf::Tyre::from_file)
+/// (reader and the one validation; refused files are an error) and every
+/// warning of the reader and the validation on stderr.
+pub(crate) fn load_tyre(path: &std::path::Path) -> crate::Result<crate::mf::Tyre> {
+    let t = crate::mf::Tyre::from_file(path)?;
+    show_warnings(&path.display().to_string(), t.warnings());
+    Ok(t)
+}
+
+/// Print a tyre file's warnings on stderr, one a line, naming the file.
+pub(crate) fn show_warnings(source: &str, warnings: &[String]) {
+    for w in warnings {
+        eprintln!("tyrekit: warning: {source}: {w}");
+    }
+}
+
 /// Entry point used by `src/main.rs`; returns the process exit code.
 pub fn main() -> i32 {
     let cli = match Cli::try_parse() {

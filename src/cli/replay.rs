@@ -4,7 +4,7 @@
 //!
 //! Must never: panic on a bad file or flag (errors name the file and flag).
 
-use crate::mf::{Tyre, UseMode};
+use crate::mf::UseMode;
 use crate::residual::{replay, write_csv, ReplayOptions};
 use crate::transient::TransientKind;
 use crate::{Error, Result};
@@ -50,7 +50,7 @@ pub fn run(a: Args) -> Result<()> {
             a.transient
         )));
     }
-    let tyre = Tyre::from_file(&a.tir)?;
+    let tyre = super::load_tyre(&a.tir)?;
     // "file": the tyre file's [TYREKIT] TRANSIENT (a bad value there is
     // an error naming the file and key), steady without one.
     let kind = TransientKind::resolve(&a.transient, tyre.params())?;

@@ -60,9 +60,33 @@ fn parse_chunk(text: &str, ncol: usize, sep: char) -> Result<Vec<Vec<f64>>, Chun
     Ok(cols)
 }
 
+/// The most rows any reader accepts (CSV, TTC .dat/.mat, TYDEX): 2 million,
+/// 5.5 h at 100 Hz or 33 min at 1 kHz. Interpreting a recording costs about
+/// 250 bytes per row whatever the file's size per row, so this is what keeps a
+/// 50 MB hostile file of short rows within 1 GB (`tests/reader_bounds.rs`).
+pub const MAX_ROWS: usize = 2_000_000;
+
+/// Refuse a table of more than [`MAX_ROWS`] rows, naming the file.
+pub(crate) fn limit_rows(t: RawTable, file: &str) -> Result<RawTable> {
+    let n = t.columns.iter().map(|c| c.data.len()).max().unwrap_or(0);
+    if n > MAX_ROWS {
+        return Err(rerr(
+            file,
+            "data",
+            format!("{n} rows, more than the {MAX_ROWS} a recording may have; split the file"),
+        ));
+    }
+    Ok(t)
+}
+
 /// Read CSV bytes into a raw table (units from `[unit]` suffixes if present).
 /// Large files are parsed on two threads (split at a line boundary).
 pub fn read(bytes: &[u8], file: &str) -> Result<RawTable> {
+    super::csvio::limit_rows(read_unbounded(bytes, file)?, file)
+}
+
+/// [`read`] without the row limit.
+fn read_unbounded(bytes: &[u8], file: &str) -> Result<RawTable> {
     let text = std::str::from_utf8(bytes)
         .map_err(|e| rerr(file, format!("byte {}", e.valid_up_to()), "not UTF-8 text"))?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);

@@ -148,9 +148,33 @@ fn err<T>(location: &str, message: impl Into<String>) -> R<T> {
     })
 }
 
-/// Upper bound for a single decompressed element (protects against zip bombs
-/// and corrupt lengths): 4 GiB.
-const MAX_INFLATE: u64 = 4 << 30;
+/// Deepest nesting of structs and cells accepted (TTC files nest 3 deep; a
+/// hostile file nested 10 000 deep overflowed the stack).
+pub const MAX_DEPTH: usize = 32;
+/// Inflated bytes allowed per byte of file (zlib reaches ~1000:1 on a bomb;
+/// measurement data compresses 1.2–5:1).
+pub const INFLATE_RATIO: usize = 64;
+/// Absolute cap on the inflated bytes of one file (all its variables).
+pub const MAX_INFLATED: usize = 256 << 20;
+/// Absolute cap on the numeric values of one file (all its arrays): 256 MiB
+/// of f64; with [`MAX_INFLATED`] this bounds the reader's peak memory
+/// (measured in `tests/reader_bounds.rs`).
+pub const MAX_VALUES: usize = 32 << 20;
+
+/// What one file may still use (shared by the decoding threads).
+struct Budget {
+    inflated: std::sync::atomic::AtomicUsize,
+    values: std::sync::atomic::AtomicUsize,
+}
+
+impl Budget {
+    /// Take `n` from `pool`; false (and nothing taken) when it has less.
+    fn take(pool: &std::sync::atomic::AtomicUsize, n: usize) -> bool {
+        use std::sync::atomic::Ordering::SeqCst;
+        pool.fetch_update(SeqCst, SeqCst, |left| left.checked_sub(n))
+            .is_ok()
+    }
+}
 
 /// Read all variables of a level-5 MAT file, in file order.
 pub fn read(bytes: &[u8]) -> R<Vec<(String, MatValue)>> {
@@ -219,15 +243,35 @@ pub fn read(bytes: &[u8]) -> R<Vec<(String, MatValue)>> {
             "trailing partial element (file truncated)",
         );
     }
+    let cap = bytes.len().saturating_mul(INFLATE_RATIO).saturating_add(1 << 20).min(MAX_INFLATED);
+    let budget = Budget {
+        inflated: cap.into(),
+        values: MAX_VALUES.into(),
+    };
     let decode = |(ty, a, b, loc): &(u32, usize, usize, String)| -> R<(String, MatValue)> {
         let body = &bytes[*a..*b];
         if *ty == mi::MATRIX {
-            return matrix(body, big, loc);
+            return matrix(body, big, loc, 0, &budget);
         }
         let mut dec = Vec::new();
-        flate2::read::ZlibDecoder::new(body)
-            .take(MAX_INFLATE)
-            .read_to_end(&mut dec)
+        let left = budget.inflated.load(std::sync::atomic::Ordering::SeqCst);
+        let inflated = flate2::read::ZlibDecoder::new(body)
+            .take(left as u64 + 1)
+            .read_to_end(&mut dec);
+        if dec.len() > left || !Budget::take(&budget.inflated, dec.len()) {
+            return err(
+                loc,
+                format!(
+                    "compressed variables inflate to more than {} MiB for a {}-byte file \
+                     (at most {INFLATE_RATIO} times the file size, {} MiB in all): \
+                     a decompression bomb or a corrupt file; refused",
+                    cap >> 20,
+                    bytes.len(),
+                    MAX_INFLATED >> 20
+                ),
+            );
+        }
+        inflated
             .map_err(|e| MatError {
                 location: loc.clone(),
                 message: format!(
@@ -247,7 +291,7 @@ pub fn read(bytes: &[u8]) -> R<Vec<(String, MatValue)>> {
                 "compressed variable is shorter than its declared size (truncated)",
             );
         }
-        matrix(&dec[hdr2..hdr2 + n2], big, loc)
+        matrix(&dec[hdr2..hdr2 + n2], big, loc, 0, &budget)
     };
     // Split the work by bytes between two threads.
     let total: usize = elems.iter().map(|e| e.2 - e.1).sum();
@@ -407,7 +451,13 @@ fn to_text(ty: u32, d: &[u8], big: bool, loc: &str) -> R<Vec<char>> {
 }
 
 /// Decode the body of a miMATRIX element: (name, value).
-fn matrix(body: &[u8], big: bool, loc: &str) -> R<(String, MatValue)> {
+fn matrix(body: &[u8], big: bool, loc: &str, depth: usize, budget: &Budget) -> R<(String, MatValue)> {
+    if depth > MAX_DEPTH {
+        return err(
+            loc,
+            format!("structs/cells nested more than {MAX_DEPTH} deep; not a recording"),
+        );
+    }
     if body.is_empty() {
         // An empty miMATRIX is a valid empty array (e.g. an empty struct field).
         return Ok((
@@ -456,6 +506,16 @@ fn matrix(body: &[u8], big: bool, loc: &str) -> R<(String, MatValue)> {
     s.loc = loc.clone();
     let v = match class {
         6..=15 => {
+            if !Budget::take(&budget.values, count) {
+                return err(
+                    &loc,
+                    format!(
+                        "more than {} million numeric values in the file; refused (a recording \
+                         that large should be split)",
+                        MAX_VALUES / 1_000_000
+                    ),
+                );
+            }
             let (ty, d) = s.next("real part")?;
             let data = to_f64(ty, d, big, &loc)?;
             if data.len() != count {
@@ -538,7 +598,7 @@ fn matrix(body: &[u8], big: bool, loc: &str) -> R<(String, MatValue)> {
                             format!("field '{f}' of element {e} is type {ty}, expected miMATRIX"),
                         );
                     }
-                    vals.push(matrix(d, big, &format!("{loc}.{f}"))?.1);
+                    vals.push(matrix(d, big, &format!("{loc}.{f}"), depth + 1, budget)?.1);
                 }
                 elements.push(vals);
             }
@@ -555,7 +615,7 @@ fn matrix(body: &[u8], big: bool, loc: &str) -> R<(String, MatValue)> {
                 if ty != mi::MATRIX {
                     return err(&loc, format!("cell {i} is type {ty}, expected miMATRIX"));
                 }
-                items.push(matrix(d, big, &format!("{loc}{{{i}}}"))?.1);
+                items.push(matrix(d, big, &format!("{loc}{{{i}}}"), depth + 1, budget)?.1);
             }
             MatValue::Cell { dims, items }
         }

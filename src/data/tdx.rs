@@ -23,6 +23,11 @@ fn rerr(file: &str, loc: impl Into<String>, msg: impl Into<String>) -> Error {
 
 /// Read TYDEX text.
 pub fn read(bytes: &[u8], file: &str) -> Result<RawTable> {
+    super::csvio::limit_rows(read_unbounded(bytes, file)?, file)
+}
+
+/// [`read`] without the row limit.
+fn read_unbounded(bytes: &[u8], file: &str) -> Result<RawTable> {
     let text = String::from_utf8_lossy(bytes);
     let mut t = RawTable::default();
     let mut section = String::new();

@@ -68,6 +68,11 @@ fn channel_units(ch: &MatValue) -> Vec<(String, String)> {
 
 /// Read a TTC `.mat` export.
 pub fn read_mat(bytes: &[u8], file: &str) -> Result<RawTable> {
+    super::csvio::limit_rows(read_mat_unbounded(bytes, file)?, file)
+}
+
+/// [`read_mat`] without the row limit.
+fn read_mat_unbounded(bytes: &[u8], file: &str) -> Result<RawTable> {
     let vars = mat::read(bytes).map_err(|e| rerr(file, e.location, e.message))?;
     let mut t = RawTable::default();
     let units: Vec<(String, String)> = vars
@@ -150,6 +155,11 @@ fn split_fields(l: &str) -> Vec<&str> {
 
 /// Read a TTC `.dat` text export.
 pub fn read_dat(bytes: &[u8], file: &str) -> Result<RawTable> {
+    super::csvio::limit_rows(read_dat_unbounded(bytes, file)?, file)
+}
+
+/// [`read_dat`] without the row limit.
+fn read_dat_unbounded(bytes: &[u8], file: &str) -> Result<RawTable> {
     let text = std::str::from_utf8(bytes).map_err(|e| {
         rerr(
             file,

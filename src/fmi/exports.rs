@@ -230,6 +230,15 @@ pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
         if let Some(inst) = instance(c) {
             inst.event("freed");
             inst.tag = 0;
+            // Every FMU state the master did not free goes with its instance
+            // (each holds a copy of the simulation and a share of the tyre).
+            for addr in std::mem::take(&mut inst.states) {
+                let snap = addr as *mut Snapshot;
+                if (*snap).tag == SNAPSHOT_TAG {
+                    (*snap).tag = 0;
+                    drop(Box::from_raw(snap));
+                }
+            }
             drop(Box::from_raw(c as *mut Instance));
         }
     }));
@@ -419,8 +428,11 @@ pub unsafe extern "C" fn fmi2GetFMUstate(c: fmi2Component, state: *mut fmi2FMUst
             let snap = Box::new(Snapshot {
                 tag: SNAPSHOT_TAG,
                 sim: inst.sim.clone(),
+                owner: c as usize,
             });
-            *state = Box::into_raw(snap) as fmi2FMUstate;
+            let p = Box::into_raw(snap);
+            inst.states.push(p as usize);
+            *state = p as fmi2FMUstate;
         } else {
             snapshot_ref(*state)?;
             let snap = &mut *(*state as *mut Snapshot);
@@ -445,11 +457,16 @@ pub unsafe extern "C" fn fmi2FreeFMUstate(
     c: fmi2Component,
     state: *mut fmi2FMUstate,
 ) -> Fmi2Status {
-    guarded(c, "fmi2FreeFMUstate", allowed::ALL_LIVE, |_inst| {
+    guarded(c, "fmi2FreeFMUstate", allowed::ALL_LIVE, |inst| {
         if state.is_null() || (*state).is_null() {
             return Ok(Fmi2Status::Ok);
         }
-        snapshot_ref(*state)?;
+        let owner = snapshot_ref(*state)?.owner;
+        if owner != c as usize {
+            return Err("FMUstate belongs to another instance; free it with that one".into());
+        }
+        let addr = *state as usize;
+        inst.states.retain(|&a| a != addr);
         let mut snap = Box::from_raw(*state as *mut Snapshot);
         snap.tag = 0;
         drop(snap);
@@ -515,10 +532,13 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
         let data = slice(bytes as *const u8, size, "serializedState")?;
         let sim = snapshot::deserialize(inst, data)?;
         if (*state).is_null() {
-            *state = Box::into_raw(Box::new(Snapshot {
+            let p = Box::into_raw(Box::new(Snapshot {
                 tag: SNAPSHOT_TAG,
                 sim,
-            })) as fmi2FMUstate;
+                owner: c as usize,
+            }));
+            inst.states.push(p as usize);
+            *state = p as fmi2FMUstate;
         } else {
             snapshot_ref(*state)?;
             (*(*state as *mut Snapshot)).sim = sim;

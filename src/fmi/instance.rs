@@ -125,6 +125,9 @@ pub struct Loaded {
     pub key: String,
     /// The file actually read.
     pub path: PathBuf,
+    /// FNV-1a of the file's bytes: an FMU state records it and is refused
+    /// by an instance whose tyre differs (states never carry a path).
+    pub hash: u64,
 }
 
 /// Everything an FMU state captures (fmi2GetFMUstate clones this).
@@ -153,6 +156,9 @@ pub struct Instance {
     /// The start-value variant of the interface the master instantiated
     /// (its GUID named it; `vars::START_VARIANTS`), None for the default XML.
     pub variant: Option<StartVariant>,
+    /// Addresses of the FMU states (`Box<Snapshot>`) this instance created
+    /// and the master has not freed: fmi2FreeInstance frees them.
+    pub states: Vec<usize>,
 }
 
 /// A parameter's start value differing from the default XML: (name, value).
@@ -255,11 +261,17 @@ pub fn load_tyre(resources: &Path, key: &str) -> Result<Loaded, String> {
             resources.join(p)
         }
     };
-    let tyre = Tyre::from_file(&path)
-        .map_err(|e| format!("cannot load tyre property file {}: {e}", path.display()))?;
+    // Bounded, non-blocking read of a regular file only (a FIFO or a device
+    // as tyre_file is refused at once), then the one validation of a tyre.
+    let fail = |e: crate::Error| format!("cannot load tyre property file {}: {e}", path.display());
+    let bytes = crate::tir::read_file(&path).map_err(fail)?;
+    let params = crate::tir::TyreParams::from_bytes(&bytes, &path.display().to_string())
+        .map_err(fail)?;
+    let tyre = Tyre::checked(params).map_err(fail)?;
     Ok(Loaded {
         tyre: Arc::new(tyre),
         key: key.to_string(),
+        hash: super::snapshot::fnv1a(&bytes),
         path,
     })
 }
@@ -278,13 +290,75 @@ const INPUTS: [(usize, &str); 10] = [
     (real::ALPHA_IN, "alpha_in"),
 ];
 
-/// Why an input value is refused (`None` = acceptable).
-fn input_problem(slot: usize, x: f64) -> Option<&'static str> {
-    if !x.is_finite() {
-        return Some("is not finite (NaN or infinite)");
+/// The hard limits (min, max) of a Real slot, from the modelDescription's
+/// `min`/`max` attributes (the generated table: one source of truth).
+const fn limits_of(slot: usize) -> (f64, f64) {
+    let mut i = 0;
+    while i < vars::VARIABLES.len() {
+        let v = &vars::VARIABLES[i];
+        if matches!(v.ty, VarType::Real) && v.slot == slot {
+            return (v.min, v.max);
+        }
+        i += 1;
     }
-    if (slot == real::P || slot == real::MU_SCALE) && x < 0.0 {
-        return Some("must not be negative");
+    (f64::NEG_INFINITY, f64::INFINITY)
+}
+
+/// (min, max) of every Real slot, built at compile time (the setters' check).
+const REAL_LIMITS: [(f64, f64); real::N] = {
+    let mut out = [(0.0, 0.0); real::N];
+    let mut i = 0;
+    while i < real::N {
+        out[i] = limits_of(i);
+        i += 1;
+    }
+    out
+};
+
+/// (slot, min, max) of every checked input, built at compile time.
+const LIMITS: [(usize, f64, f64); INPUTS.len()] = {
+    let mut out = [(0, 0.0, 0.0); INPUTS.len()];
+    let mut i = 0;
+    while i < INPUTS.len() {
+        let (lo, hi) = limits_of(INPUTS[i].0);
+        out[i] = (INPUTS[i].0, lo, hi);
+        i += 1;
+    }
+    out
+};
+
+/// The load above which a step is refused for this tyre: FZ_LIMIT_FACTOR ×
+/// max(FNOMIN, FZMAX) (the Magic Formula's load terms are polynomials in
+/// dfz = Fz/Fz0 − 1 that turn over far outside the measured range).
+pub const FZ_LIMIT_FACTOR: f64 = 10.0;
+
+/// The tyre-relative load limit (N) of [`FZ_LIMIT_FACTOR`].
+pub fn fz_limit(tyre: &Tyre) -> f64 {
+    let p = &tyre.params().p;
+    FZ_LIMIT_FACTOR * p.fnomin.max(if p.fzmax.is_finite() { p.fzmax } else { 0.0 })
+}
+
+/// The lowest inflation pressure (Pa) accepted besides the sentinel 0 (=
+/// the file's INFLPRES): below 0.1 bar a tyre is flat, and the Magic
+/// Formula's pressure terms ((p/NOMPRES)^QSY7 …) diverge (p = 1e-300 Pa gave
+/// My = −7e125 N·m with the limit checks off).
+pub const P_MIN: f64 = 1e4;
+
+/// Why an input value is refused (`None` = acceptable).
+fn input_problem(slot: usize, x: f64) -> Option<String> {
+    if !x.is_finite() {
+        return Some("is not finite (NaN or infinite)".into());
+    }
+    if slot == real::P && x > 0.0 && x < P_MIN {
+        return Some(format!(
+            "is below {P_MIN} Pa (0.1 bar, a flat tyre) and not 0 (= the file's INFLPRES)"
+        ));
+    }
+    let (lo, hi) = REAL_LIMITS.get(slot).copied().unwrap_or((f64::NEG_INFINITY, f64::INFINITY));
+    if !(lo..=hi).contains(&x) {
+        return Some(format!(
+            "is outside its physical range [{lo}, {hi}] (min/max in modelDescription.xml)"
+        ));
     }
     None
 }
@@ -356,13 +430,15 @@ fn advance(
     dt: f64,
 ) -> Result<(), String> {
     let r = &values.reals;
-    // Fast check first (no branch per input); the message only on failure.
-    let mut ok = r[real::P] >= 0.0 && r[real::MU_SCALE] >= 0.0;
-    for (slot, _) in INPUTS {
-        ok &= r[slot].is_finite();
+    // Fast check first (no branch per input; NaN fails every comparison);
+    // the message only on failure.
+    let mut ok = r[real::FZ] <= fz_limit(tyre);
+    for (slot, lo, hi) in LIMITS {
+        ok &= r[slot] >= lo && r[slot] <= hi;
     }
+    ok &= r[real::P] == 0.0 || r[real::P] >= P_MIN;
     if !ok {
-        return Err(input_error(r));
+        return Err(input_error(r, tyre));
     }
     let inp = WheelInput {
         vx: r[real::VX],
@@ -438,11 +514,19 @@ fn all_finite(o: &WheelOutput) -> bool {
 
 /// The message for refused inputs (cold path).
 #[cold]
-fn input_error(r: &[f64]) -> String {
+fn input_error(r: &[f64], tyre: &Tyre) -> String {
     for (slot, name) in INPUTS {
         if let Some(why) = input_problem(slot, r[slot]) {
-            return format!("input {name} = {} {why}", r[slot]);
+            return format!("input {name} = {} {why}; step refused, nothing changed", r[slot]);
         }
+    }
+    let lim = fz_limit(tyre);
+    if r[real::FZ] > lim {
+        return format!(
+            "input Fz = {} N is above {FZ_LIMIT_FACTOR} x max(FNOMIN, FZMAX) = {lim} N of the \
+             loaded tyre, where the Magic Formula has no meaning; step refused, nothing changed",
+            r[real::FZ]
+        );
     }
     "inputs refused".into()
 }
@@ -602,6 +686,7 @@ impl Instance {
             default_tyre,
             sim,
             variant,
+            states: Vec::new(),
         });
         for w in &inst.default_tyre.tyre.params().warnings {
             inst.log.status(Fmi2Status::Warning, w);
@@ -880,16 +965,5 @@ impl Instance {
         }
         self.sim.clone_from(sim);
         Ok(())
-    }
-
-    /// The tyre for a `tyre_file` value, reusing what is loaded where possible.
-    pub fn tyre_for(&self, key: &str) -> Result<Loaded, String> {
-        if key == self.sim.loaded.key {
-            Ok(self.sim.loaded.clone())
-        } else if key.trim().is_empty() {
-            Ok(self.default_tyre.clone())
-        } else {
-            load_tyre(&self.resources, key)
-        }
     }
 }

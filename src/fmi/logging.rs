@@ -145,11 +145,17 @@ impl Logger {
                 }
             }
         }
+        if on {
+            // FMI 2.0 §2.1.5: with loggingOn and a category list, only the
+            // listed categories are logged — except errors and fatal errors,
+            // which always reach the master (a refused call must say why).
+            self.enabled = [false; 5];
+            self.enabled[Category::StatusError as usize] = true;
+            self.enabled[Category::StatusFatal as usize] = true;
+            self.debug = true;
+        }
         for i in idx {
             self.enabled[i] = on;
-        }
-        if on {
-            self.debug = true;
         }
         Ok(())
     }

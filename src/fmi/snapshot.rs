@@ -3,19 +3,25 @@
 //! An fmi2FMUstate is a `Box<Snapshot>`: a tag and a complete copy of the
 //! instance's [`Sim`] (the loaded tyre is shared through an `Arc`).
 //!
-//! Serialized format, little-endian, version 1:
+//! Serialized format, little-endian, version 2:
 //! ```text
 //! magic     8 bytes  "TYREKIT\x01"... see MAGIC
 //! version   u32      FORMAT_VERSION
 //! length    u64      total length in bytes, header and checksum included
 //! guid      u64      FNV-1a of the GUID: a state only fits the interface it came from
+//! tyre      u64      FNV-1a of the bytes of the tyre file the state belongs to
 //! payload   phase u8, time f64, start f64, stop flag u8 + f64,
 //!           reals N×f64, integers N×i32, booleans N×u8 (0/1),
-//!           strings N×(u32 length + UTF-8 bytes), transient state N_STATES×f64
+//!           strings N×(u32 length + UTF-8 bytes) except tyre_file,
+//!           transient state N_STATES×f64
 //! checksum  u64      FNV-1a of everything before it
 //! ```
-//! The tyre itself is not serialized: its `tyre_file` value is, and the tyre is
-//! reloaded from it on deserialization when it is not the one already loaded.
+//! A state never carries a path and deserializing never opens a file (a
+//! checksum anyone can recompute protects against accidents, not against a
+//! crafted buffer: the defence is that a state cannot name files). It carries
+//! the hash of the tyre content instead and is refused unless that is the
+//! tyre the instance has loaded (its current `tyre_file`, or the packaged
+//! resources/tyre.tir); `tyre_file` is restored as the matching one's value.
 //! Must never: read outside the buffer, accept a buffer that fails any check,
 //! or dereference a state pointer without checking its tag.
 
@@ -27,7 +33,7 @@ use std::ffi::CString;
 /// First bytes of every serialized state.
 pub const MAGIC: [u8; 8] = *b"TKFMUST\x01";
 /// Version of the byte format.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 /// Tag of a live snapshot.
 pub const SNAPSHOT_TAG: u64 = 0x5459_5245_5354_4154; // "TYRESTAT"
 
@@ -36,6 +42,9 @@ pub const SNAPSHOT_TAG: u64 = 0x5459_5245_5354_4154; // "TYRESTAT"
 pub struct Snapshot {
     pub tag: u64,
     pub sim: Sim,
+    /// The instance that created it (only it may free it; fmi2FreeInstance
+    /// frees every state its instance still owns).
+    pub owner: usize,
 }
 
 /// FNV-1a 64.
@@ -48,7 +57,7 @@ pub fn fnv1a(bytes: &[u8]) -> u64 {
     h
 }
 
-const HEADER: usize = 8 + 4 + 8 + 8;
+const HEADER: usize = 8 + 4 + 8 + 8 + 8;
 
 /// Serialize a state.
 pub fn serialize(sim: &Sim) -> Vec<u8> {
@@ -57,6 +66,7 @@ pub fn serialize(sim: &Sim) -> Vec<u8> {
     b.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
     b.extend_from_slice(&0u64.to_le_bytes()); // length, patched below
     b.extend_from_slice(&fnv1a(vars::GUID.as_bytes()).to_le_bytes());
+    b.extend_from_slice(&sim.loaded.hash.to_le_bytes());
     b.push(sim.phase as u8);
     b.extend_from_slice(&sim.time.to_le_bytes());
     b.extend_from_slice(&sim.start_time.to_le_bytes());
@@ -71,7 +81,10 @@ pub fn serialize(sim: &Sim) -> Vec<u8> {
     for x in &sim.values.booleans {
         b.push(u8::from(*x));
     }
-    for s in &sim.values.strings {
+    for (i, s) in sim.values.strings.iter().enumerate() {
+        if i == string::TYRE_FILE {
+            continue;
+        }
         let bytes = s.as_bytes();
         b.extend_from_slice(&(bytes.len() as u32).to_le_bytes());
         b.extend_from_slice(bytes);
@@ -160,6 +173,7 @@ pub fn deserialize(inst: &Instance, bytes: &[u8]) -> Result<Sim, String> {
     if r.u64()? != fnv1a(vars::GUID.as_bytes()) {
         return Err("FMU state was saved by an FMU with another interface (GUID differs)".into());
     }
+    let tyre_hash = r.u64()?;
     let body = &bytes[..bytes.len() - 8];
     let sum = u64::from_le_bytes(bytes[bytes.len() - 8..].try_into().unwrap_or([0; 8]));
     if fnv1a(body) != sum {
@@ -193,7 +207,10 @@ pub fn deserialize(inst: &Instance, bytes: &[u8]) -> Result<Sim, String> {
             _ => return Err("FMU state holds an invalid Boolean".into()),
         };
     }
-    for s in values.strings.iter_mut() {
+    for (i, s) in values.strings.iter_mut().enumerate() {
+        if i == string::TYRE_FILE {
+            continue;
+        }
         let n = r.u32()? as usize;
         let text = std::str::from_utf8(r.take(n)?)
             .map_err(|_| "FMU state holds a string that is not UTF-8".to_string())?;
@@ -212,7 +229,20 @@ pub fn deserialize(inst: &Instance, bytes: &[u8]) -> Result<Sim, String> {
             bytes.len() - 8 - r.at
         ));
     }
-    let loaded = inst.tyre_for(values.string(string::TYRE_FILE))?;
+    let loaded = if tyre_hash == inst.sim.loaded.hash {
+        inst.sim.loaded.clone()
+    } else if tyre_hash == inst.default_tyre.hash {
+        inst.default_tyre.clone()
+    } else {
+        return Err(format!(
+            "FMU state belongs to another tyre (content hash {tyre_hash:016x}; this instance has \
+             {:016x} loaded from {}): set the same tyre_file first; a state never names a file",
+            inst.sim.loaded.hash,
+            inst.sim.loaded.path.display()
+        ));
+    };
+    values.strings[string::TYRE_FILE] =
+        CString::new(loaded.key.as_str()).map_err(|_| "tyre_file with NUL".to_string())?;
     let d = derive(&values, &loaded.tyre)?;
     let mut model = crate::transient::TransientModel::with_options(d.config, d.options);
     model.state.x = x;

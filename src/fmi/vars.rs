@@ -68,6 +68,10 @@ pub struct VarInfo {
     pub variability: Variability,
     pub start: Start,
     pub unit: &'static str,
+    /// Hard lower limit of a Real (`min` of the XML; −inf when none).
+    pub min: f64,
+    /// Hard upper limit of a Real (`max` of the XML; +inf when none).
+    pub max: f64,
     pub description: &'static str,
 }
 

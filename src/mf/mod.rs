@@ -53,6 +53,7 @@ pub mod equations;
 pub mod extras;
 pub mod limits;
 pub mod real;
+pub mod validate;
 
 pub use equations::{Form, LoadTerms, Model, Solution};
 pub use limits::{Clamped, Conditions};
@@ -282,9 +283,31 @@ impl Tyre {
         let ext = crate::transient::extension::Extension::from_params(&params)?;
         Ok(Tyre { params, model, ext })
     }
-    /// Load a `.tir` file and prepare it.
+    /// Load a `.tir` file, prepare and [`validate`] it: refused with the
+    /// reason when the model cannot be evaluated at nominal conditions; the
+    /// validation's doubts are appended to [`TyreParams::warnings`] (after the
+    /// reader's), which every command prints.
     pub fn from_file(path: &std::path::Path) -> crate::Result<Tyre> {
-        Tyre::new(TyreParams::from_file(path)?)
+        Tyre::checked(TyreParams::from_file(path)?)
+    }
+    /// [`Tyre::new`] plus the one validation every entry point applies
+    /// ([`validate::check`]): the fit's output, the CLI and the FMU use this.
+    pub fn checked(params: TyreParams) -> crate::Result<Tyre> {
+        let mut t = Tyre::new(params)?;
+        match validate::check(&t) {
+            Ok(w) => {
+                t.params.warnings.extend(w);
+                Ok(t)
+            }
+            Err(why) => Err(crate::Error::Other(format!(
+                "{}: tyre refused: {why}",
+                t.params.source
+            ))),
+        }
+    }
+    /// The warnings of loading this tyre: the reader's, then the validation's.
+    pub fn warnings(&self) -> &[String] {
+        &self.params.warnings
     }
     /// The built-in default tyre.
     pub fn builtin() -> Tyre {

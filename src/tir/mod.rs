@@ -110,23 +110,80 @@ pub struct TyreParams {
     pub doc: TirDoc,
 }
 
+/// Largest `.tir` accepted (bytes): 80 times the largest published file
+/// (MF 6.2 template, 26 kB). Together with linear-time reading and capped
+/// warnings this bounds the reader's memory (measured in
+/// `tests/reader_bounds.rs`).
+pub const MAX_TIR_BYTES: usize = 2 << 20;
+
+fn too_big(n: usize, name: &str) -> Result<()> {
+    if n > MAX_TIR_BYTES {
+        return Err(Error::Tir {
+            file: name.to_string(),
+            line: 0,
+            key: String::new(),
+            message: format!(
+                "{n} bytes, more than any tyre property file (limit {MAX_TIR_BYTES} bytes); \
+                 is this a .tir?"
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// The bytes of a `.tir` file: only a regular file (not a FIFO, device or
+/// directory) of at most [`MAX_TIR_BYTES`], opened non-blocking so that a
+/// FIFO cannot stall the caller (the FMU's `tyre_file`), read no further
+/// than the limit (so `/dev/zero`-like files cannot fill memory).
+pub fn read_file(path: &Path) -> Result<Vec<u8>> {
+    use std::io::Read;
+    let mut o = std::fs::OpenOptions::new();
+    o.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        o.custom_flags(libc::O_NONBLOCK);
+    }
+    let f = o.open(path).map_err(|e| Error::io(path, e))?;
+    let meta = f.metadata().map_err(|e| Error::io(path, e))?;
+    let name = path.display().to_string();
+    if !meta.is_file() {
+        return Err(Error::Tir {
+            file: name,
+            line: 0,
+            key: String::new(),
+            message: "not a regular file (a directory, FIFO or device); give a .tir file".into(),
+        });
+    }
+    too_big(meta.len().try_into().unwrap_or(usize::MAX), &name)?;
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    f.take(MAX_TIR_BYTES as u64 + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| Error::io(path, e))?;
+    too_big(bytes.len(), &name)?;
+    Ok(bytes)
+}
+
 /// The built-in tyre's property file (MF 6.1, SI; see its header for the source).
 pub const BUILTIN_TIR: &str = include_str!("builtin.tir");
 
 impl TyreParams {
-    /// Read a `.tir` file from disk.
+    /// Read a `.tir` file from disk ([`read_file`]: a regular file of at most
+    /// [`MAX_TIR_BYTES`], opened without blocking).
     pub fn from_file(path: &Path) -> Result<Self> {
-        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        let bytes = read_file(path)?;
         Self::from_bytes(&bytes, &path.display().to_string())
     }
 
     /// Parse `.tir` bytes (UTF-8, or Latin-1 when not valid UTF-8); `name` labels errors.
     pub fn from_bytes(bytes: &[u8], name: &str) -> Result<Self> {
+        too_big(bytes.len(), name)?;
         Self::from_tir_str(&parse::decode(bytes), name)
     }
 
     /// Parse `.tir` text; `name` labels errors.
     pub fn from_tir_str(text: &str, name: &str) -> Result<Self> {
+        too_big(text.len(), name)?;
         let r = read::read(text, name)?;
         Ok(TyreParams {
             version: r.version,

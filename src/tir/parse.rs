@@ -347,6 +347,9 @@ pub fn parse_doc(text: &str, warnings: &mut Vec<String>) -> TirDoc {
     let mut block = Block::None;
     // A table started by `{...}` or by a first numeric row in the current section.
     let mut table_line_of_section: Option<usize> = None;
+    // Section index by upper-case name: a file of many distinct sections
+    // reads in linear time (a linear search per header was quadratic).
+    let mut by_name: std::collections::HashMap<String, usize> = Default::default();
 
     for (i, raw_line) in text.split('\n').enumerate() {
         let ln = i + 1;
@@ -393,11 +396,7 @@ pub fn parse_doc(text: &str, warnings: &mut Vec<String>) -> TirDoc {
                     }
                 };
                 let name = name.to_string();
-                match doc
-                    .sections
-                    .iter()
-                    .position(|s| s.name.eq_ignore_ascii_case(&name))
-                {
+                match by_name.get(&name.to_ascii_uppercase()).copied() {
                     Some(k) => {
                         warnings.push(format!(
                             "line {ln}: section [{name}] appears again (first at line {}); \
@@ -407,6 +406,7 @@ pub fn parse_doc(text: &str, warnings: &mut Vec<String>) -> TirDoc {
                         cur = Some(k);
                     }
                     None => {
+                        by_name.insert(name.to_ascii_uppercase(), doc.sections.len());
                         doc.sections.push(Section {
                             name,
                             line: ln,

@@ -63,6 +63,9 @@ pub fn read(text: &str, file: &str) -> Result<ReadOut> {
 
     for sec in doc.sections.iter_mut() {
         let entries = std::mem::take(&mut sec.entries);
+        // First line of each unknown key of this section (upper case), for the
+        // duplicate warning; duplicates are removed after the loop in linear time.
+        let mut seen: std::collections::HashMap<String, usize> = Default::default();
         for e in entries {
             if e.key.eq_ignore_ascii_case("TYRESIDE") {
                 if side_line != 0 {
@@ -79,7 +82,7 @@ pub fn read(text: &str, file: &str) -> Result<ReadOut> {
                 continue;
             }
             let Some(i) = lookup_key(&e.key) else {
-                keep_unknown(sec, e, &units, &mut warnings, &mut unconverted);
+                keep_unknown(sec, e, &units, &mut warnings, &mut unconverted, &mut seen);
                 continue;
             };
             let def = &KEYS[i];
@@ -140,8 +143,12 @@ pub fn read(text: &str, file: &str) -> Result<ReadOut> {
                 }
             }
         }
+        if seen.len() < sec.entries.len() {
+            keep_last(&mut sec.entries);
+        }
         convert_table(sec, &units, &mut warnings);
     }
+    cap_warnings(&mut warnings);
     plausibility(&p, &given, &units, &mut warnings);
     for (k, c) in comments {
         doc.key_comments.insert(k.to_string(), c);
@@ -179,6 +186,7 @@ fn keep_unknown(
     units: &Units,
     warnings: &mut Vec<String>,
     unconverted: &mut Vec<String>,
+    seen: &mut std::collections::HashMap<String, usize>,
 ) {
     if let Some((legacy, real)) = LEGACY_SPELLINGS
         .iter()
@@ -190,21 +198,46 @@ fn keep_unknown(
             e.line
         ));
     }
-    if let Some(k) = sec
-        .entries
-        .iter()
-        .position(|o| o.key.eq_ignore_ascii_case(&e.key))
-    {
+    let upper = e.key.to_ascii_uppercase();
+    if let Some(first) = seen.get(&upper) {
         warnings.push(format!(
-            "line {}: {} given again in [{}] (first at line {}); the later value is used",
-            e.line, e.key, sec.name, sec.entries[k].line
+            "line {}: {} given again in [{}] (first at line {first}); the later value is used",
+            e.line, e.key, sec.name
         ));
-        sec.entries.remove(k);
+    } else {
+        seen.insert(upper, e.line);
     }
     if matches!(e.value, Value::Number(_)) && !units.is_si() {
         unconverted.push(format!("{} (line {})", e.key, e.line));
     }
     sec.entries.push(e);
+}
+
+/// Keep only the last entry of each key (case-insensitive), in the order of
+/// those last entries: what removing the earlier one at each duplicate gave,
+/// in linear time.
+fn keep_last(entries: &mut Vec<super::parse::Entry>) {
+    let mut seen = std::collections::HashSet::new();
+    let mut out: Vec<super::parse::Entry> = std::mem::take(entries)
+        .into_iter()
+        .rev()
+        .filter(|e| seen.insert(e.key.to_ascii_uppercase()))
+        .collect();
+    out.reverse();
+    *entries = out;
+}
+
+/// At most this many warnings are kept (a hostile file can give one per
+/// line); the rest are counted in a last warning.
+pub const MAX_WARNINGS: usize = 200;
+
+fn cap_warnings(w: &mut Vec<String>) {
+    if w.len() > MAX_WARNINGS {
+        let more = w.len() - MAX_WARNINGS;
+        w.truncate(MAX_WARNINGS);
+        w.push(format!("… and {more} more warnings (only the first {MAX_WARNINGS} are listed)"));
+        w.shrink_to_fit();
+    }
 }
 
 fn parse_side(v: &Value, line: usize, warnings: &mut Vec<String>) -> TyreSide {

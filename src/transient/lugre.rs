@@ -344,7 +344,13 @@ fn elastoplastic(z: f64, zss: f64, vr: f64, beta: f64) -> f64 {
     }
 }
 
+/// LuGre forces never exceed this multiple of the friction limit
+/// max(μ_i·Fz, |F_i,MF|) per direction (see [`step`]).
+pub const LUGRE_FRICTION_MARGIN: f64 = 1.05;
+
 /// One LuGre step (see the module docs); updates slots 0, 1 of `st`.
+/// |F_i| ≤ [`LUGRE_FRICTION_MARGIN`]·max(μ_i·Fz, |F_i,MF|) in any slip history.
+
 pub(crate) fn step(c: &StepCtx, p: &LuGreParams, st: &mut TransientState, dt: f64) -> WheelOutput {
     let fz = c.fz;
     let vrx = -c.kin.vsx;
@@ -460,6 +466,23 @@ pub(crate) fn step(c: &StepCtx, p: &LuGreParams, st: &mut TransientState, dt: f6
     let dzy = vry - thy_e * zy;
     let fx = f0x + fz * (s0x * zx + s1x * dzx + p.sigma2 * vrx);
     let fy = f0y + fz * (s0y * zy + s1y * dzy + p.sigma2 * vry);
+    // The friction limit (issue 16): the damping term σ1·ż is unbounded at a
+    // slip reversal (ż ≈ vr while z has not followed), which gave |Fx| = 5·Fz
+    // at 100 m/s with reversals every 0.5 ms. No bristle force exceeds what
+    // friction can transmit, so each force is clamped to
+    // LUGRE_FRICTION_MARGIN·max(μ_i·Fz, |F_i,MF|) (μ_i with the road scale;
+    // F_i,MF the steady Magic Formula at the same slips, which the steady
+    // state equals, so steady states are unchanged).
+    let lim = |mu: f64, f_mf: f64| {
+        let l = LUGRE_FRICTION_MARGIN * (c.s * mu * fz).abs().max(f_mf.abs());
+        if l.is_finite() {
+            l
+        } else {
+            f64::INFINITY
+        }
+    };
+    let fx = fx.clamp(-lim(c.props.mux, o.fx), lim(c.props.mux, o.fx));
+    let fy = fy.clamp(-lim(c.props.muy, o.fy), lim(c.props.muy, o.fy));
     // Aligning moment: the MF's, scaled by the ratio of dynamic to steady Fy
     // (the pneumatic trail of the steady state; bounded to stay sane when
     // the steady Fy is near zero).

@@ -74,6 +74,10 @@ pub use lugre::{LuGreFriction, LuGreParams};
 use crate::mf::{Forces, LoadTerms, MfInput, SlipProps, Tyre, UseMode};
 use crate::tir::MfVersion;
 
+/// The speed (m/s) at which the Magic Formula is evaluated for vx = 0 with
+/// turn slip on: the limit vx → 0+ (see [`TransientModel::step`]).
+pub const TURN_SLIP_VX0: f64 = 1e-9;
+
 /// Which dynamics sit between the wheel's motion and the Magic Formula.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum TransientKind {
@@ -811,13 +815,22 @@ impl TransientModel {
         let s = validate(self.config.input_mode, inp, dt)?;
         let fz = inp.fz.max(0.0);
         let mode = self.config.use_mode;
+        // Turn slip at exactly vx = 0: the MF's turn-slip shape (Pacejka 4.86,
+        // D_Hyφ ∝ sgn Vx, and B_Hyφ ∝ 1/D_Hyφ) is 0/0 there, while its limit
+        // for vx → 0+ is finite (and the low-speed reduction has already
+        // faded φt and κ to 0): evaluate at that limit (issue 16).
+        let vx_mf = if mode.turn_slip && inp.vx == 0.0 {
+            TURN_SLIP_VX0
+        } else {
+            inp.vx
+        };
         let base = MfInput {
             fz,
             kappa: 0.0,
             alpha: 0.0,
             gamma: inp.gamma,
             phit: inp.phit,
-            vx: inp.vx,
+            vx: vx_mf,
             p: inp.p,
             omega: inp.omega,
         };

@@ -38,7 +38,8 @@ pub struct Args {
     /// only when named).
     #[arg(long, value_delimiter = ',')]
     pub only: Vec<String>,
-    /// Hold data out of the fit: none, run[:K], condition[:K].
+    /// Hold data out of the fit: none, run[:K], condition[:K], tail:F (the last
+    /// fraction F of each recording's time, e.g. tail:0.3).
     #[arg(long, default_value = "none")]
     pub holdout: String,
     /// Directory for fit.json and the SVG plots.
@@ -94,11 +95,8 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(m) = &args.model {
         start.version = parse_model(m)?;
     }
-    let recs: Vec<Recording> = args
-        .recordings
-        .iter()
-        .map(|p| Recording::from_file(p))
-        .collect::<Result<_>>()?;
+    let (recs, t_origins) = load_recordings(&args.recordings)?;
+    opts.t_origins = t_origins;
 
     let bar = std::io::stderr().is_terminal().then(|| {
         let b = indicatif::ProgressBar::new(100);
@@ -137,6 +135,19 @@ pub fn run(args: Args) -> Result<()> {
         println!("wrote {} and {n} plots", dir.join("fit.json").display());
     }
     Ok(())
+}
+
+/// The recordings, and per recording the time of its first row before the
+/// warm-up cut (the origin of `--holdout tail:F`).
+fn load_recordings(paths: &[PathBuf]) -> Result<(Vec<Recording>, Vec<Option<f64>>)> {
+    let mut recs = Vec::new();
+    let mut origins = Vec::new();
+    for p in paths {
+        let l = crate::data::load(p, &crate::data::LoadOptions::default())?;
+        origins.push(l.report.warmup.as_ref().map(|w| w.t_start));
+        recs.push(l.recording);
+    }
+    Ok((recs, origins))
 }
 
 /// One SVG per (channel, condition): measured points and the model curve at

@@ -1,5 +1,11 @@
 //! holdout — split a recording's segments into the part a fit sees and the
-//! part it is judged on (`--holdout run` or `--holdout condition`).
+//! part it is judged on (`--holdout run`, `--holdout condition` or
+//! `--holdout tail:F`).
+//!
+//! `tail:F` is the honest split of a time series: the last fraction F of the
+//! recording's time is held out (`tail:0.3` fits the first 70 %), measured
+//! from the recording's first row — before any warm-up cut when the caller
+//! passes that time ([`Holdout::split_from`]) — to its last sample.
 //!
 //! Deterministic: every k-th run (segment, in time order) or every k-th
 //! distinct condition (sorted by load, inclination, pressure) is held out,
@@ -14,7 +20,7 @@ use crate::data::Recording;
 use std::ops::Range;
 
 /// How to hold data out of a fit.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Holdout {
     None,
     /// Every `every`-th segment.
@@ -24,6 +30,10 @@ pub enum Holdout {
     /// Every `every`-th distinct test condition (all its segments).
     ByCondition {
         every: usize,
+    },
+    /// The last `frac` (0 < frac < 1) of the recording's time.
+    Tail {
+        frac: f64,
     },
 }
 
@@ -49,8 +59,24 @@ impl Split {
 }
 
 impl Holdout {
-    /// Parse `none`, `run`, `run:K`, `condition`, `condition:K` (default K = 5).
+    /// Parse `none`, `run`, `run:K`, `condition`, `condition:K` (default K
+    /// = 5) or `tail:F` (0 < F < 1).
     pub fn parse(s: &str) -> crate::Result<Holdout> {
+        if let Some((a, b)) = s.split_once(':') {
+            if a.trim().eq_ignore_ascii_case("tail") {
+                return b
+                    .trim()
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|f| *f > 0.0 && *f < 1.0)
+                    .map(|frac| Holdout::Tail { frac })
+                    .ok_or_else(|| {
+                        crate::Error::Input(format!(
+                            "--holdout '{s}': after 'tail:' expected the held-out fraction of the recording's time, between 0 and 1 (e.g. tail:0.3)"
+                        ))
+                    });
+            }
+        }
         let (kind, k) = match s.split_once(':') {
             Some((a, b)) => (
                 a,
@@ -67,7 +93,7 @@ impl Holdout {
             "run" | "runs" => Ok(Holdout::ByRun { every: k }),
             "condition" | "conditions" => Ok(Holdout::ByCondition { every: k }),
             _ => Err(crate::Error::Input(format!(
-                "--holdout '{s}': expected none, run, run:K, condition or condition:K"
+                "--holdout '{s}': expected none, run, run:K, condition, condition:K or tail:F"
             ))),
         }
     }
@@ -75,10 +101,16 @@ impl Holdout {
     /// Split the segments of `rec`. Samples outside every segment go to the
     /// training half (they are fit data only if the caller uses them).
     pub fn split(&self, rec: &Recording) -> Split {
+        self.split_from(rec, None)
+    }
+
+    /// As [`Holdout::split`], with the time the recording began (its first
+    /// row, before a warm-up cut) for `tail:F`; `None`: the first sample's.
+    pub fn split_from(&self, rec: &Recording, t_origin: Option<f64>) -> Split {
         let n = rec.samples.len();
         let segs = &rec.segments;
         let held: Vec<bool> = match *self {
-            Holdout::None => vec![false; segs.len()],
+            Holdout::None | Holdout::Tail { .. } => vec![false; segs.len()],
             Holdout::ByRun { every } => {
                 let mut h: Vec<bool> = (0..segs.len()).map(|i| (i + 1) % every == 0).collect();
                 if !h.iter().any(|&x| x) && segs.len() >= 2 {
@@ -104,6 +136,15 @@ impl Holdout {
         };
         // Mark samples, then turn the marks into ranges.
         let mut mark = vec![false; n];
+        if let Holdout::Tail { frac } = *self {
+            // Last time, not last sample: time may go backwards in a file.
+            let t_last = rec.samples.iter().map(|s| s.time).fold(f64::MIN, f64::max);
+            let first = rec.samples.first().map_or(0.0, |s| s.time);
+            let cut = t_last - frac * (t_last - t_origin.unwrap_or(first).min(first));
+            for (m, s) in mark.iter_mut().zip(&rec.samples) {
+                *m = s.time >= cut;
+            }
+        }
         for (s, &h) in segs.iter().zip(&held) {
             // A malformed segment (start ≥ end, or past the samples) marks nothing.
             let (a, b) = (s.start.min(n), s.end.min(n));

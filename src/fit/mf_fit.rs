@@ -30,6 +30,10 @@ pub struct MfFitOptions {
     /// off by default).
     pub transient: bool,
     pub holdout: Holdout,
+    /// Per recording (same order): the time its first row was recorded,
+    /// before a warm-up cut — the origin of `--holdout tail:F`'s time
+    /// fraction. Empty or `None`: the first kept sample's time.
+    pub t_origins: Vec<Option<f64>>,
     /// Take FNOMIN, NOMPRES (and INFLPRES), LONGVL from the data.
     pub nominal_from_data: bool,
     pub threads: usize,
@@ -44,6 +48,7 @@ impl Default for MfFitOptions {
             only: StageKind::ALL.to_vec(),
             transient: false,
             holdout: Holdout::None,
+            t_origins: Vec::new(),
             nominal_from_data: true,
             threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
             fit: FitOptions {
@@ -206,8 +211,11 @@ pub fn fit_mf(
     let form = form_of(tyre.version);
     let splits: Vec<TrainTest> = recs
         .iter()
-        .map(|r| {
-            let s = opts.holdout.split(r);
+        .enumerate()
+        .map(|(i, r)| {
+            let s = opts
+                .holdout
+                .split_from(r, opts.t_origins.get(i).copied().flatten());
             (s.train, s.test)
         })
         .collect();

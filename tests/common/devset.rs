@@ -38,7 +38,9 @@ pub struct Answer {
 pub fn answers(dir: &Path) -> Option<Vec<Answer>> {
     let text = std::fs::read_to_string(dir.join("answers.json")).ok()?;
     let v: serde_json::Value = serde_json::from_str(&text).expect("answers.json is JSON");
-    let recs = v["recordings"].as_object().expect("answers.json: recordings");
+    let recs = v["recordings"]
+        .as_object()
+        .expect("answers.json: recordings");
     let mut out: Vec<Answer> = recs
         .iter()
         .map(|(name, a)| {
@@ -183,7 +185,10 @@ pub fn read_sim(path: &Path) -> HashMap<i64, [f64; 3]> {
     let (t, fx, fy, mz) = (col("time"), col("Fx_sim"), col("Fy_sim"), col("Mz_sim"));
     let mut out = HashMap::new();
     for l in lines {
-        let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap_or(f64::NAN)).collect();
+        let v: Vec<f64> = l
+            .split(',')
+            .map(|x| x.parse().unwrap_or(f64::NAN))
+            .collect();
         out.insert((v[t] * 100.0).round() as i64, [v[fx], -v[fy], -v[mz]]);
     }
     out

@@ -10,12 +10,13 @@
 use super::holdout::Holdout;
 use super::metrics::{self, ChannelMetric};
 use super::mf_stages::{
-    conditions_of, fit_stage, gather, stage_params, Channel, StageKind, CAMBER_SPREAD,
-    PRESSURE_SPREAD,
+    conditions_of, fit_stage_from, gather, neutral_start, stage_params, Channel, StageKind,
+    CAMBER_SPREAD, PRESSURE_SPREAD,
 };
 use super::report::FitReport;
 use super::solve::{FitOptions, ProgressFn};
-use crate::data::Recording;
+use super::validity::Grid;
+use crate::data::{Recording, SegmentKind};
 use crate::mf::{form_of, Model};
 use crate::tir::TyreParams;
 use std::ops::Range;
@@ -162,6 +163,26 @@ pub fn widen_ranges(tyre: &mut TyreParams, recs: &[Recording]) -> crate::Result<
     Ok(())
 }
 
+/// The range of load, inclination and pressure of every loaded sample of
+/// `recs`: where a fitted tyre must be valid ([`super::validity`]).
+pub fn data_grid(recs: &[Recording]) -> Grid {
+    let span = |f: &dyn Fn(&crate::data::Sample) -> f64| {
+        recs.iter()
+            .flat_map(|r| &r.samples)
+            .filter(|s| s.fz > 0.0)
+            .map(f)
+            .filter(|v| v.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(v), b.max(v))
+            })
+    };
+    Grid::spanning(
+        span(&|s| s.fz),
+        span(&|s| s.gamma),
+        span(&|s| if s.p > 0.0 { s.p } else { f64::NAN }),
+    )
+}
+
 /// Check the hold list of `opts` against the coefficients the stages fit:
 /// an unknown name is an error naming it (a typo must not silently fit
 /// the coefficient it meant to hold).
@@ -221,6 +242,7 @@ pub fn fit_mf(
     } else {
         None
     };
+    let grid = data_grid(recs);
     let form = form_of(tyre.version);
     let splits: Vec<TrainTest> = recs
         .iter()
@@ -243,11 +265,14 @@ pub fn fit_mf(
         if !opts.only.contains(&kind) {
             continue;
         }
-        let (seg, channels) = kind.segments_and_channels();
-        if channels
+        let (seg, all_channels) = kind.segments_and_channels();
+        let recorded = |c: &Channel| recs.iter().any(|r| r.has(c.name()));
+        let channels: &[Channel] = &all_channels
             .iter()
-            .any(|c| !recs.iter().any(|r| r.has(c.name())))
-        {
+            .copied()
+            .filter(|c| recorded(c) || !kind.optional(*c))
+            .collect::<Vec<_>>();
+        if !channels.iter().all(recorded) {
             skipped.push(format!(
                 "{}: the data have no {:?} channel",
                 kind.name(),
@@ -255,7 +280,8 @@ pub fn fit_mf(
             ));
             continue;
         }
-        let data = gather(&tyre.p, recs, Some(&train), seg, channels);
+        let mut data = gather(&tyre.p, recs, Some(&train), seg, channels);
+        data.grid = Some(grid.clone());
         if data.conds.len() < opts.min_samples {
             skipped.push(format!(
                 "{}: {} samples in {} segments (need {})",
@@ -266,13 +292,28 @@ pub fn fit_mf(
             ));
             continue;
         }
+        if kind == StageKind::Combined {
+            // The combined weights act on the pure rows too (κ and α are
+            // never exactly 0 there: Gyκ, SVyκ, Gxα and Mz's s·Fx apply), so
+            // the stage fits them with the combined rows: fitted on the
+            // combined runs alone they were free to spoil the pure ones
+            // (dev set: pure Fy 1.01 → 2.03 × baseline on r04).
+            for pure in [SegmentKind::PureLateral, SegmentKind::PureLongitudinal] {
+                data.append(gather(&tyre.p, recs, Some(&train), pure, channels));
+            }
+        }
         let params = stage_params(
             kind,
             &tyre.p,
             data.gamma_spread < CAMBER_SPREAD,
             data.p_spread < PRESSURE_SPREAD,
         );
-        let out = fit_stage(
+        let extra = if matches!(kind, StageKind::Mx | StageKind::My) {
+            Vec::new()
+        } else {
+            vec![neutral_start(kind, &params)]
+        };
+        let out = fit_stage_from(
             form,
             &tyre.p,
             &params,
@@ -282,6 +323,7 @@ pub fn fit_mf(
             &opts.fit,
             kind.name(),
             progress.as_deref_mut(),
+            &extra,
         )?;
         for p in &out.params {
             tyre.set(&p.name, p.value)?;

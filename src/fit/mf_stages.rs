@@ -29,6 +29,7 @@ use super::channels;
 use super::grad_pure;
 use super::problem::{par_rows, Param, Problem, RowJacobian, Stack};
 use super::solve::{fit_global, FitOptions, FitOutcome, ProgressFn};
+use super::validity::{Grid, Validity};
 use crate::data::{Recording, Sample, SegmentKind};
 use crate::mf::{Conditions, Form, MfInput, Model, UseMode};
 use crate::tir::keys::key_index;
@@ -93,10 +94,19 @@ impl StageKind {
             StageKind::PureFx => (SegmentKind::PureLongitudinal, &[Channel::Fx]),
             StageKind::PureFy => (SegmentKind::PureLateral, &[Channel::Fy]),
             StageKind::Mz => (SegmentKind::PureLateral, &[Channel::Mz]),
-            StageKind::Combined => (SegmentKind::Combined, &[Channel::Fx, Channel::Fy]),
+            // Mz where recorded (see [`StageKind::optional`]): its combined
+            // terms (SSZ*) act only with Fx ≠ 0, and Gyκ, Gxα shape it too.
+            StageKind::Combined => (
+                SegmentKind::Combined,
+                &[Channel::Fx, Channel::Fy, Channel::Mz],
+            ),
             StageKind::Mx => (SegmentKind::PureLateral, &[Channel::Mx]),
             StageKind::My => (SegmentKind::PureLongitudinal, &[Channel::My]),
         }
+    }
+    /// Whether the stage runs without `channel` (fitting the others).
+    pub fn optional(self, channel: Channel) -> bool {
+        self == StageKind::Combined && channel == Channel::Mz
     }
     /// The stage's parameters: (key, lower, upper, depends on camber, depends on pressure).
     pub fn table(self) -> &'static [(&'static str, f64, f64, bool, bool)] {
@@ -157,30 +167,32 @@ const MZ: &[(&str, f64, f64, bool, bool)] = &[
     ("qez1", -50.0, 1.0, false, false), ("qez2", -50.0, 50.0, false, false),
     ("qez3", -50.0, 50.0, false, false), ("qez4", -10.0, 10.0, false, false),
     ("qhz1", -0.1, 0.1, false, false), ("qhz2", -0.1, 0.1, false, false),
-    ("ssz1", -0.5, 0.5, false, false), ("ssz2", -0.5, 0.5, false, false),
     ("qbz5", -50.0, 50.0, C, false), ("qbz6", -50.0, 50.0, C, false),
     ("qdz3", -50.0, 50.0, C, false), ("qdz4", -50.0, 50.0, C, false),
     ("qdz8", -50.0, 50.0, C, false), ("qdz9", -50.0, 50.0, C, false),
     ("qdz10", -50.0, 50.0, C, false), ("qdz11", -50.0, 50.0, C, false),
     ("qez5", -50.0, 50.0, C, false), ("qhz3", -5.0, 5.0, C, false),
-    ("qhz4", -5.0, 5.0, C, false), ("ssz3", -5.0, 5.0, C, false),
-    ("ssz4", -5.0, 5.0, C, false),
+    ("qhz4", -5.0, 5.0, C, false),
     ("ppz1", -10.0, 10.0, false, P), ("ppz2", -10.0, 10.0, C, P),
 ];
 #[rustfmt::skip]
 const COMBINED: &[(&str, f64, f64, bool, bool)] = &[
     ("rbx1", 0.0, 200.0, false, false), ("rbx2", -200.0, 200.0, false, false),
-    ("rcx1", 0.3, 3.0, false, false), ("rex1", -20.0, 1.0, false, false),
+    ("rcx1", 0.3, 1.0, false, false), ("rex1", -20.0, 1.0, false, false),
     ("rex2", -20.0, 20.0, false, false), ("rhx1", -0.1, 0.1, false, false),
     ("rby1", 0.0, 200.0, false, false), ("rby2", -200.0, 200.0, false, false),
-    ("rby3", -1.0, 1.0, false, false), ("rcy1", 0.3, 3.0, false, false),
+    ("rby3", -1.0, 1.0, false, false), ("rcy1", 0.3, 1.0, false, false),
     ("rey1", -20.0, 1.0, false, false), ("rey2", -20.0, 20.0, false, false),
     ("rhy1", -0.1, 0.1, false, false), ("rhy2", -0.1, 0.1, false, false),
     ("rvy1", -1.0, 1.0, false, false), ("rvy2", -1.0, 1.0, false, false),
     ("rvy4", -200.0, 200.0, false, false), ("rvy5", 0.0, 10.0, false, false),
     ("rvy6", -200.0, 200.0, false, false),
+    // Mz's combined-slip moment arm of Fx (4.E76), fitted only here: on
+    // pure lateral data Fx ≈ 0 and they are not identified.
+    ("ssz1", -0.5, 0.5, false, false), ("ssz2", -0.5, 0.5, false, false),
     ("rbx3", -500.0, 500.0, C, false), ("rby4", -500.0, 500.0, C, false),
     ("rvy3", -50.0, 50.0, C, false),
+    ("ssz3", -5.0, 5.0, C, false), ("ssz4", -5.0, 5.0, C, false),
 ];
 
 // Mx: Besselink's MF 6.1 draft eq. (49) as evaluated in `Model::mx`; My:
@@ -221,9 +233,22 @@ pub struct StageData {
     /// Spread (max − min) of inclination and pressure over the samples.
     pub gamma_spread: f64,
     pub p_spread: f64,
+    /// The range the MF's validity conditions must hold on
+    /// ([`super::validity`]); `None`: no validity rows.
+    pub grid: Option<Grid>,
 }
 
 impl StageData {
+    /// Append the samples of `other` (same channels); spreads widen to
+    /// cover both.
+    pub fn append(&mut self, other: StageData) {
+        self.conds.extend(other.conds);
+        for (m, o) in self.meas.iter_mut().zip(other.meas) {
+            m.extend(o);
+        }
+        self.gamma_spread = self.gamma_spread.max(other.gamma_spread);
+        self.p_spread = self.p_spread.max(other.p_spread);
+    }
     /// Every `k`-th sample (spreads kept: they decide which terms are held).
     pub fn every(&self, k: usize) -> StageData {
         let k = k.max(1);
@@ -236,6 +261,7 @@ impl StageData {
                 .collect(),
             gamma_spread: self.gamma_spread,
             p_spread: self.p_spread,
+            grid: self.grid.clone(),
         }
     }
 }
@@ -264,6 +290,36 @@ pub fn fit_stage(
     opts: &FitOptions,
     name: &str,
     progress: Option<&mut ProgressFn>,
+) -> crate::Result<FitOutcome> {
+    fit_stage_from(
+        form,
+        base,
+        params,
+        data,
+        channels,
+        threads,
+        opts,
+        name,
+        progress,
+        &[],
+    )
+}
+
+/// [`fit_stage`] from the parameters' start and the `extra_starts` (θ
+/// vectors over `params`): the candidate with the least full-data cost after
+/// converging on the subsample is polished ([`best_start`]).
+#[allow(clippy::too_many_arguments)]
+pub fn fit_stage_from(
+    form: Form,
+    base: &MfParams<f64>,
+    params: &[Param],
+    data: &StageData,
+    channels: &[Channel],
+    threads: usize,
+    opts: &FitOptions,
+    name: &str,
+    progress: Option<&mut ProgressFn>,
+    extra_starts: &[Vec<f64>],
 ) -> crate::Result<FitOutcome> {
     let m = data.conds.len();
     let coarse =
@@ -304,38 +360,148 @@ pub fn fit_stage(
         Some(d) => parts_of(form, base, params, d, channels, &weights, threads)?,
         None => Vec::new(),
     };
-    let (stack, coarse_stack);
-    let problem: &dyn Problem = if parts.len() == 1 {
-        &parts[0]
-    } else {
-        stack = Stack::new(parts.iter().map(|p| (p as &dyn Problem, 1.0)).collect())?;
-        &stack
+    // The validity rows, scaled to the weighted energy of the data they join.
+    let validity = |d: &StageData| -> crate::Result<Option<Validity>> {
+        let Some(grid) = &d.grid else { return Ok(None) };
+        let energy: f64 = d
+            .meas
+            .iter()
+            .zip(&weights)
+            .map(|(y, w)| w * y.iter().map(|v| v * v).sum::<f64>())
+            .sum();
+        Ok(Some(Validity::new(form, base, params, grid, energy)?))
     };
-    let coarse_problem: Option<&dyn Problem> = match coarse_parts.len() {
-        0 => None,
-        1 => Some(&coarse_parts[0]),
-        _ => {
-            coarse_stack = Stack::new(
-                coarse_parts
-                    .iter()
-                    .map(|p| (p as &dyn Problem, 1.0))
-                    .collect(),
-            )?;
-            Some(&coarse_stack)
+    let valid = validity(data)?;
+    let coarse_valid = match &coarse {
+        Some(d) => validity(d)?,
+        None => None,
+    };
+    fn stacked<'p>(
+        parts: &'p [MfStage<'_>],
+        valid: &'p Option<Validity>,
+    ) -> crate::Result<Option<Stack<'p>>> {
+        if parts.is_empty() || (parts.len() == 1 && valid.is_none()) {
+            return Ok(None);
         }
+        let mut v: Vec<(&dyn Problem, f64)> =
+            parts.iter().map(|p| (p as &dyn Problem, 1.0)).collect();
+        if let Some(val) = valid {
+            v.push((val as &dyn Problem, 1.0));
+        }
+        Ok(Some(Stack::new(v)?))
+    }
+    let stack = stacked(&parts, &valid)?;
+    let coarse_stack = stacked(&coarse_parts, &coarse_valid)?;
+    let problem: &dyn Problem = match &stack {
+        Some(s) => s,
+        None => &parts[0],
     };
-    fit_global(problem, coarse_problem, None, None, opts, name, progress)
+    let coarse_problem: Option<&dyn Problem> = match (&coarse_stack, coarse_parts.first()) {
+        (Some(s), _) => Some(s),
+        (None, Some(p)) => Some(p),
+        (None, None) => None,
+    };
+    let mut start = None;
+    if !extra_starts.is_empty() {
+        start = Some(best_start(
+            problem,
+            coarse_problem,
+            extra_starts,
+            opts,
+            name,
+        )?);
+    }
+    fit_global(
+        problem,
+        coarse_problem,
+        start.as_deref(),
+        None,
+        opts,
+        name,
+        progress,
+    )
 }
 
-/// The use mode of fitting: no range limits (the start tyre's ranges must
-/// not clip the data), no α*, no turn slip.
+/// Several starts (issue #14 item 3): the problem's own and `extra`, each
+/// converged on the subsample `coarse` (to 1e-6; on the problem itself when
+/// there is none), judged by the full problem's cost — with a subsample
+/// that is the error on the (k − 1)/k samples the candidate was not fitted
+/// on, a held-out figure. Returns the best converged point.
+fn best_start(
+    problem: &dyn Problem,
+    coarse: Option<&dyn Problem>,
+    extra: &[Vec<f64>],
+    opts: &FitOptions,
+    name: &str,
+) -> crate::Result<Vec<f64>> {
+    let own: Vec<f64> = problem.params().iter().map(|p| p.start).collect();
+    let mut loose = opts.clone();
+    loose.lm.ftol = loose.lm.ftol.max(1e-6);
+    loose.lm.xtol = loose.lm.xtol.max(1e-6);
+    loose.lm.gtol = loose.lm.gtol.max(1e-6);
+    loose.coarse_first = false;
+    let on = coarse.unwrap_or(problem);
+    let mut r = vec![0.0; problem.n_residuals()];
+    let mut best: Option<(f64, Vec<f64>)> = None;
+    for s in std::iter::once(&own).chain(extra) {
+        // A start the model cannot evaluate is skipped.
+        let Ok(o) = fit_global(on, None, Some(s), None, &loose, name, None) else {
+            continue;
+        };
+        problem.residuals(&o.theta, &mut r);
+        let c = opts.lm.loss.cost(&r, problem.weights());
+        if c.is_finite() && best.as_ref().is_none_or(|b| c < b.0) {
+            best = Some((c, o.theta));
+        }
+    }
+    Ok(best.map_or(own, |b| b.1))
+}
+
+/// The neutral start of a stage's free parameters: the shape, shift,
+/// curvature and camber terms at 0, only the primary factors (C, D, K and
+/// their load terms, Bt, Ct, Dt of the trail, the combined weights' B and C)
+/// kept — a second start far from a poor minimum the first may sit in
+/// (a curvature factor driven to a bound, a trail shape fitted by camber
+/// terms). Fixed parameters keep their values.
+pub fn neutral_start(kind: StageKind, params: &[Param]) -> Vec<f64> {
+    const KEEP: &[&str] = &[
+        "pcy1", "pdy1", "pdy2", "pky1", "pky2", "pky4", "pcx1", "pdx1", "pdx2", "pkx1", "pkx2",
+        "qbz1", "qcz1", "qdz1", "qdz2", "rbx1", "rbx2", "rcx1", "rby1", "rby2", "rcy1",
+    ];
+    let _ = kind;
+    params
+        .iter()
+        .map(|p| {
+            if !p.free || KEEP.contains(&p.name.as_str()) {
+                p.start
+            } else {
+                p.clamp(0.0)
+            }
+        })
+        .collect()
+}
+
+/// A use mode with no range limits, no α*, no turn slip (211): what the fit
+/// used before it evaluated the way the FMU does; kept for comparisons.
 pub const FIT_MODE: UseMode = UseMode {
     limits: false,
     alpha_star: false,
     turn_slip: false,
 };
 
-/// The conditioned inputs of a sample (pressure NaN → the file's INFLPRES).
+/// The use mode the fit evaluates in: the FMU's default, 111 (range limits
+/// on — `fit_mf` widens the file's ranges to the data first —, no α*, no
+/// turn slip), so every figure the fit reports is what the written file
+/// gives where it is used; [`super::validity`] keeps the caps of 1xx from
+/// acting, so 211 agrees on the data range.
+pub const USE_MODE: UseMode = UseMode {
+    limits: true,
+    alpha_star: false,
+    turn_slip: false,
+};
+
+/// The conditioned inputs of a sample in [`USE_MODE`] (pressure NaN → the
+/// file's INFLPRES).
 pub fn conditions_of(p: &MfParams<f64>, s: &Sample) -> Conditions {
     let inp = MfInput {
         fz: s.fz,
@@ -347,7 +513,7 @@ pub fn conditions_of(p: &MfParams<f64>, s: &Sample) -> Conditions {
         p: s.p,
         omega: 0.0,
     };
-    Conditions::new(p, &inp, FIT_MODE).0
+    Conditions::new(p, &inp, USE_MODE).0
 }
 
 /// Gather the samples of `kind` segments inside `train` (None: everything)
@@ -529,12 +695,7 @@ impl<'a> MfStage<'a> {
 
     /// The base parameters with θ written in.
     pub fn params_at(&self, theta: &[f64]) -> MfParams<f64> {
-        let mut p = self.base.clone();
-        let s = p.as_mut_slice();
-        for (&k, &v) in self.keys.iter().zip(theta) {
-            s[k] = v;
-        }
-        p
+        params_with(&self.base, &self.keys, theta)
     }
 
     /// The channel simulated at every stage sample.
@@ -564,6 +725,17 @@ impl<'a> MfStage<'a> {
             });
         Model::new(pd, self.form)
     }
+}
+
+/// `base` with θ written in at the key indices `keys`
+/// ([`MfParams::as_slice`] order).
+pub(crate) fn params_with(base: &MfParams<f64>, keys: &[usize], theta: &[f64]) -> MfParams<f64> {
+    let mut p = base.clone();
+    let s = p.as_mut_slice();
+    for (&k, &v) in keys.iter().zip(theta) {
+        s[k] = v;
+    }
+    p
 }
 
 /// The closed-form row Jacobian of an [`MfStage`] at one θ.

@@ -50,6 +50,7 @@ pub mod recording;
 pub mod report;
 pub mod solve;
 pub mod transient;
+pub mod validity;
 
 pub use holdout::{Holdout, Split};
 pub use identify::{IdentifyOptions, Verdict};

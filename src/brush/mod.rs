@@ -24,7 +24,7 @@
 //! Magic Formula ([`params`]). Selectable as the force model of the
 //! transient models (`TransientOptions::brush`), in `eval`/`replay`
 //! (`--force-model brush`), the FMU (`force_model = brush`), fitted by
-//! `fit --model brush` (`crate::fit::brush`); the paper's study is [`study`].
+//! `fit --model brush` (`crate::fit::brush`); the paper's study is still to do.
 //!
 //! Must never: allocate in [`BrushParams::forces`], or return a non-finite
 //! force for finite inputs.
@@ -33,7 +33,6 @@ mod carcass;
 mod contact;
 mod params;
 mod solver;
-pub mod study;
 pub(crate) mod transient;
 
 pub use carcass::StringCarcass;

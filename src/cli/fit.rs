@@ -61,7 +61,7 @@ fn parse_model(s: &str) -> Result<MfVersion> {
         "mf52" => Ok(MfVersion::Mf52),
         "pac2002" => Ok(MfVersion::Pac2002),
         _ => Err(Error::Input(format!(
-            "--model '{s}': expected mf61, mf62, mf52 or pac2002"
+            "--model '{s}': expected mf61, mf62, mf52, pac2002 or brush"
         ))),
     }
 }
@@ -98,7 +98,11 @@ pub fn run(args: Args) -> Result<()> {
         }
         None => TyreParams::builtin(),
     };
-    if let Some(m) = &args.model {
+    let brush = args
+        .model
+        .as_deref()
+        .is_some_and(|m| m.eq_ignore_ascii_case("brush"));
+    if let Some(m) = args.model.as_ref().filter(|_| !brush) {
         start.version = parse_model(m)?;
     }
     let start_tyre = (args.read.re.is_some())
@@ -132,6 +136,41 @@ pub fn run(args: Args) -> Result<()> {
     let res = fit_mf(&recs, start, &opts, Some(&mut cb))?;
     if let Some(b) = &bar {
         b.finish_and_clear();
+    }
+    let mut res = res;
+    if brush {
+        // The brush beside the MF: started from the fitted MF's defaults,
+        // written as the [BRUSH] section of the same file.
+        let mf = Tyre::new(res.tyre.clone())?;
+        let (b0, _) = crate::brush::BrushParams::from_tyre(&mf)?;
+        let bf = crate::fit::brush::fit_brush(&recs, b0)?;
+        bf.params.write_to(&mut res.tyre);
+        let mode = crate::mf::UseMode::default();
+        let (mfy, mmz, mfx) = crate::fit::brush::pure_slip_sigmas(&recs, &|fz, k, t, p| {
+            let f = mf.forces(
+                &crate::mf::MfInput {
+                    fz,
+                    kappa: k,
+                    alpha: t.atan(),
+                    p,
+                    vx: 10.0,
+                    ..Default::default()
+                },
+                mode,
+            );
+            (f.fx, f.fy, f.mz)
+        });
+        println!(
+            "brush fit ({} side-slip, {} longitudinal samples at |gamma| <= 0.5 deg, {} LM iterations): CPY {:.4e} N/m2, CPX {:.4e} N/m2, CARCASS_COMPLIANCE {:.4e} m/N, SIGMA_C {:.3} m, MUK {:.3}, MU_DFZ {:.3}",
+            bf.n_lateral, bf.n_longitudinal, bf.iterations, bf.params.cpy, bf.params.cpx,
+            bf.params.compliance, bf.params.sigma_c, bf.params.mu_k, bf.params.mu_dfz
+        );
+        println!("pure slip   sigma_Fy  sigma_Mz  sigma_Fx");
+        println!(
+            "brush       {:8.4}  {:8.4}  {:8.4}",
+            bf.sigma_fy, bf.sigma_mz, bf.sigma_fx
+        );
+        println!("MF          {mfy:8.4}  {mmz:8.4}  {mfx:8.4}");
     }
     // The fitted tyre passes the same validation as any loaded one before
     // it is written (a refusal is an error; doubts are shown).

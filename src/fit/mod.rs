@@ -34,6 +34,7 @@
 //! fitted samples or on a [`Holdout`] split; [`FitReport`] prints tables and
 //! writes `fit.json`. Progress: pass `Some(&mut |p: &Progress| …)`.
 
+pub mod brush;
 pub mod channels;
 pub mod geometry;
 pub mod grad_pure;

@@ -177,7 +177,6 @@ pub fn run(args: Args) -> Result<()> {
     let checked = Tyre::checked(res.tyre.clone())?;
     let n_read = res.tyre.warnings.len();
     super::show_warnings(&args.out.display().to_string(), &checked.warnings()[n_read..]);
-    res.tyre.write(&args.out)?;
     for s in &res.skipped {
         eprintln!("tyrekit fit: stage skipped: {s}");
     }

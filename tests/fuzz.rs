@@ -32,7 +32,10 @@ const HANG_SECONDS: f64 = 20.0;
 const MEMORY_BOUND: u64 = 1 << 30;
 
 fn count() -> usize {
-    if let Some(n) = std::env::var("TYREKIT_FUZZ_N").ok().and_then(|s| s.parse().ok()) {
+    if let Some(n) = std::env::var("TYREKIT_FUZZ_N")
+        .ok()
+        .and_then(|s| s.parse().ok())
+    {
         return n;
     }
     if std::env::var("TYREKIT_FUZZ_LONG").is_ok_and(|v| v == "1") {
@@ -63,11 +66,41 @@ fn save(kind: &str, i: usize, b: &[u8]) -> String {
 }
 
 const TOKENS: &[&[u8]] = &[
-    b"0", b"-1", b"1e308", b"-1e308", b"NaN", b"inf", b"1e-320", b"=", b"\n", b",", b";",
-    b"\t", b" ", b"'", b"[", b"]", b"{", b"}", b"$", b"!", b"\xff", b"\0", b"99999999999",
-    b"\nFNOMIN = 0\n", b"\nLONGVL = 0\n", b"\nNOMPRES = -1\n", b"\nQSX1 = 1e6\n",
-    b"\nPDX1 = 1e3\n", b"\nLFZO = 0\n", b"\n[UNITS]\nLENGTH = 'mm'\n", b"\nTIME = 'hour'\n",
-    b"\nPRESMAX = 0\n", b"\nFZMAX = -1\n", b"\nVXLOW = 0\n", b"\nUNLOADED_RADIUS = 1e-9\n",
+    b"0",
+    b"-1",
+    b"1e308",
+    b"-1e308",
+    b"NaN",
+    b"inf",
+    b"1e-320",
+    b"=",
+    b"\n",
+    b",",
+    b";",
+    b"\t",
+    b" ",
+    b"'",
+    b"[",
+    b"]",
+    b"{",
+    b"}",
+    b"$",
+    b"!",
+    b"\xff",
+    b"\0",
+    b"99999999999",
+    b"\nFNOMIN = 0\n",
+    b"\nLONGVL = 0\n",
+    b"\nNOMPRES = -1\n",
+    b"\nQSX1 = 1e6\n",
+    b"\nPDX1 = 1e3\n",
+    b"\nLFZO = 0\n",
+    b"\n[UNITS]\nLENGTH = 'mm'\n",
+    b"\nTIME = 'hour'\n",
+    b"\nPRESMAX = 0\n",
+    b"\nFZMAX = -1\n",
+    b"\nVXLOW = 0\n",
+    b"\nUNLOADED_RADIUS = 1e-9\n",
 ];
 
 /// Byte-level mutations (flip, insert token, delete, duplicate, truncate,
@@ -75,7 +108,11 @@ const TOKENS: &[&[u8]] = &[
 fn mutate(r: &mut ChaCha8Rng, b: &mut Vec<u8>) {
     // Half the mutants carry one mutation (most get past the first checks
     // and exercise the interpretation), the rest 2–6.
-    let k = if r.gen_bool(0.5) { 1 } else { r.gen_range(2..=6) };
+    let k = if r.gen_bool(0.5) {
+        1
+    } else {
+        r.gen_range(2..=6)
+    };
     for _ in 0..k {
         let len = b.len();
         match r.gen_range(0..8) {
@@ -109,14 +146,16 @@ fn mutate(r: &mut ChaCha8Rng, b: &mut Vec<u8>) {
                 let i = r.gen_range(0..len);
                 if let Some(s) = (i..len).find(|&k| b[k].is_ascii_digit()) {
                     let e = (s..len).find(|&k| !b[k].is_ascii_digit()).unwrap_or(len);
-                    let w: &[u8] = [b"0".as_slice(), b"1e300", b"7", b"-3", b"123456789"][r.gen_range(0..5)];
+                    let w: &[u8] =
+                        [b"0".as_slice(), b"1e300", b"7", b"-3", b"123456789"][r.gen_range(0..5)];
                     b.splice(s..e, w.iter().copied());
                 }
             }
             6 if len > 4 => {
                 // Overwrite a 4-byte word (binary lengths and tags of .mat).
                 let i = r.gen_range(0..len - 3);
-                let w: u32 = [0, 1, 0xffff_ffff, 0x7fff_ffff, 14, 15, 1 << 20, r.gen()][r.gen_range(0..8)];
+                let w: u32 =
+                    [0, 1, 0xffff_ffff, 0x7fff_ffff, 14, 15, 1 << 20, r.gen()][r.gen_range(0..8)];
                 b[i..i + 4].copy_from_slice(&w.to_le_bytes());
             }
             _ => {
@@ -129,7 +168,12 @@ fn mutate(r: &mut ChaCha8Rng, b: &mut Vec<u8>) {
 }
 
 /// Run `f` on `n` mutants of `seeds`; panics and hangs fail with the input saved.
-fn fuzz(kind: &str, salt: u64, seeds: &[Vec<u8>], mut f: impl FnMut(&[u8]) -> Result<(), String>) -> (usize, usize) {
+fn fuzz(
+    kind: &str,
+    salt: u64,
+    seeds: &[Vec<u8>],
+    mut f: impl FnMut(&[u8]) -> Result<(), String>,
+) -> (usize, usize) {
     let mut r = rng(salt);
     let n = count();
     let mut accepted = 0;
@@ -142,12 +186,21 @@ fn fuzz(kind: &str, salt: u64, seeds: &[Vec<u8>], mut f: impl FnMut(&[u8]) -> Re
         let dt = t0.elapsed().as_secs_f64();
         slowest = slowest.max(dt);
         match out {
-            Err(_) => panic!("{kind} mutant {i}: panic; input saved to {}", save(kind, i, &b)),
-            Ok(Err(why)) => panic!("{kind} mutant {i}: {why}; input saved to {}", save(kind, i, &b)),
+            Err(_) => panic!(
+                "{kind} mutant {i}: panic; input saved to {}",
+                save(kind, i, &b)
+            ),
+            Ok(Err(why)) => panic!(
+                "{kind} mutant {i}: {why}; input saved to {}",
+                save(kind, i, &b)
+            ),
             Ok(Ok(())) => {}
         }
         if dt > HANG_SECONDS {
-            panic!("{kind} mutant {i}: took {dt:.1} s (hang); input saved to {}", save(kind, i, &b));
+            panic!(
+                "{kind} mutant {i}: took {dt:.1} s (hang); input saved to {}",
+                save(kind, i, &b)
+            );
         }
         accepted += 1;
     }
@@ -157,7 +210,11 @@ fn fuzz(kind: &str, salt: u64, seeds: &[Vec<u8>], mut f: impl FnMut(&[u8]) -> Re
         slowest,
         rss >> 20
     );
-    assert!(rss <= MEMORY_BOUND, "{kind}: peak memory {} MiB above the bound", rss >> 20);
+    assert!(
+        rss <= MEMORY_BOUND,
+        "{kind}: peak memory {} MiB above the bound",
+        rss >> 20
+    );
     (n, accepted)
 }
 
@@ -201,7 +258,9 @@ fn check_tyre(t: &Tyre, r: &mut ChaCha8Rng) -> Result<(), String> {
             None
         };
         if let (Some(what), false) = (bad, warned) {
-            return Err(format!("{what} without a validation warning at {x:?}: {f:?}"));
+            return Err(format!(
+                "{what} without a validation warning at {x:?}: {f:?}"
+            ));
         }
     }
     Ok(())
@@ -242,19 +301,49 @@ fn fuzz_tir() {
 fn seed_table() -> RawTable {
     let t = Tyre::builtin();
     let mut cols: Vec<(&str, &str, Vec<f64>)> = vec![
-        ("ET", "s", vec![]), ("V", "kph", vec![]), ("N", "rpm", vec![]), ("SA", "deg", vec![]),
-        ("IA", "deg", vec![]), ("P", "kPa", vec![]), ("FX", "N", vec![]), ("FY", "N", vec![]),
-        ("FZ", "N", vec![]), ("MX", "N-m", vec![]), ("MZ", "N-m", vec![]), ("RL", "cm", vec![]),
+        ("ET", "s", vec![]),
+        ("V", "kph", vec![]),
+        ("N", "rpm", vec![]),
+        ("SA", "deg", vec![]),
+        ("IA", "deg", vec![]),
+        ("P", "kPa", vec![]),
+        ("FX", "N", vec![]),
+        ("FY", "N", vec![]),
+        ("FZ", "N", vec![]),
+        ("MX", "N-m", vec![]),
+        ("MZ", "N-m", vec![]),
+        ("RL", "cm", vec![]),
         ("SR", "none", vec![]),
     ];
     let mut i = 0;
     for fz in [2000.0, 4000.0] {
         for k in 0..150 {
             let a = (k as f64 / 149.0 * 2.0 - 1.0) * 0.2;
-            let o = t.evaluate(&MfInput { fz, alpha: a, vx: 11.1, ..Default::default() }, UseMode::default());
+            let o = t.evaluate(
+                &MfInput {
+                    fz,
+                    alpha: a,
+                    vx: 11.1,
+                    ..Default::default()
+                },
+                UseMode::default(),
+            );
             // SAE/TTC signs: FY, FZ, MZ, SA flip.
-            let v = [i as f64 * 0.01, 40.0, 11.1 / o.re * 60.0 / (2.0 * std::f64::consts::PI),
-                -a.to_degrees(), 0.0, 220.0, o.fx, -o.fy, -fz, o.mx, -o.mz, o.rl * 100.0, 0.0];
+            let v = [
+                i as f64 * 0.01,
+                40.0,
+                11.1 / o.re * 60.0 / (2.0 * std::f64::consts::PI),
+                -a.to_degrees(),
+                0.0,
+                220.0,
+                o.fx,
+                -o.fy,
+                -fz,
+                o.mx,
+                -o.mz,
+                o.rl * 100.0,
+                0.0,
+            ];
             for (c, x) in cols.iter_mut().zip(v) {
                 c.2.push(x);
             }
@@ -264,7 +353,11 @@ fn seed_table() -> RawTable {
     RawTable {
         columns: cols
             .into_iter()
-            .map(|(n, u, d)| RawColumn { name: n.into(), unit: Some(u.into()), data: d })
+            .map(|(n, u, d)| RawColumn {
+                name: n.into(),
+                unit: Some(u.into()),
+                data: d,
+            })
             .collect(),
         ..Default::default()
     }
@@ -297,45 +390,76 @@ fn fuzz_format(kind: &str, salt: u64, format: Format, seeds: Vec<Vec<u8>>) {
         }
     };
     let (mut ok, mut refused) = (0, 0);
-    fuzz(kind, salt, &seeds, |b| match read(b).and_then(|raw| data::from_raw(raw, format, "fuzz", &LoadOptions::default())) {
-        Ok(l) => {
-            ok += 1;
-            check_recording(&l)
-        }
-        Err(e) => {
-            refused += 1;
-            if std::env::var_os("TYREKIT_FUZZ_VERBOSE").is_some() {
-                eprintln!("refused: {e}");
+    fuzz(kind, salt, &seeds, |b| {
+        match read(b).and_then(|raw| data::from_raw(raw, format, "fuzz", &LoadOptions::default())) {
+            Ok(l) => {
+                ok += 1;
+                check_recording(&l)
             }
-            Ok(())
+            Err(e) => {
+                refused += 1;
+                if std::env::var_os("TYREKIT_FUZZ_VERBOSE").is_some() {
+                    eprintln!("refused: {e}");
+                }
+                Ok(())
+            }
         }
     });
     eprintln!("fuzz {kind}: {ok} loaded and checked, {refused} refused");
 }
 
 fn loaded_seed() -> data::Loaded {
-    data::from_raw(seed_table(), Format::TtcDat, "seed", &LoadOptions::default()).expect("seed loads")
+    data::from_raw(
+        seed_table(),
+        Format::TtcDat,
+        "seed",
+        &LoadOptions::default(),
+    )
+    .expect("seed loads")
 }
 
 #[test]
 fn fuzz_ttc_mat() {
     let t = seed_table();
-    fuzz_format("mat", 2, Format::TtcMat, vec![data::ttc::write_mat(&t, true), data::ttc::write_mat(&t, false)]);
+    fuzz_format(
+        "mat",
+        2,
+        Format::TtcMat,
+        vec![
+            data::ttc::write_mat(&t, true),
+            data::ttc::write_mat(&t, false),
+        ],
+    );
 }
 
 #[test]
 fn fuzz_ttc_dat() {
-    fuzz_format("dat", 3, Format::TtcDat, vec![data::ttc::write_dat(&seed_table()).into_bytes()]);
+    fuzz_format(
+        "dat",
+        3,
+        Format::TtcDat,
+        vec![data::ttc::write_dat(&seed_table()).into_bytes()],
+    );
 }
 
 #[test]
 fn fuzz_tydex() {
-    fuzz_format("tdx", 4, Format::Tydex, vec![data::tdx::write(&loaded_seed().recording).into_bytes()]);
+    fuzz_format(
+        "tdx",
+        4,
+        Format::Tydex,
+        vec![data::tdx::write(&loaded_seed().recording).into_bytes()],
+    );
 }
 
 #[test]
 fn fuzz_csv() {
-    fuzz_format("csv", 5, Format::Csv, vec![data::csvio::write(&loaded_seed().recording).into_bytes()]);
+    fuzz_format(
+        "csv",
+        5,
+        Format::Csv,
+        vec![data::csvio::write(&loaded_seed().recording).into_bytes()],
+    );
 }
 
 // ------------------------------------------------------------------ FMU call sequences
@@ -360,9 +484,45 @@ fn fuzz_fmu_calls() {
     let res = CString::new(format!("file://{}", dir.display())).unwrap();
     let kinds = [c"steady", c"relaxation", c"lugre"];
     let modes = [c"velocities", c"slips"];
-    let inputs = [vr::VX, vr::VY, vr::OMEGA, vr::FZ, vr::GAMMA, vr::P, vr::PHIT, vr::MU_SCALE, vr::KAPPA_IN, vr::ALPHA_IN];
-    let pool = [0.0, 1.0, -1.0, 0.3, -0.3, 10.0, 30.0, 100.0, 150.0, -150.0, 4000.0, 8000.0, 20000.0,
-        1.5, -1.5, 5.0, 2000.0, -2000.0, 2e5, 1e6, 1e300, -1e300, f64::NAN, 1e-300, 3.0];
+    let inputs = [
+        vr::VX,
+        vr::VY,
+        vr::OMEGA,
+        vr::FZ,
+        vr::GAMMA,
+        vr::P,
+        vr::PHIT,
+        vr::MU_SCALE,
+        vr::KAPPA_IN,
+        vr::ALPHA_IN,
+    ];
+    let pool = [
+        0.0,
+        1.0,
+        -1.0,
+        0.3,
+        -0.3,
+        10.0,
+        30.0,
+        100.0,
+        150.0,
+        -150.0,
+        4000.0,
+        8000.0,
+        20000.0,
+        1.5,
+        -1.5,
+        5.0,
+        2000.0,
+        -2000.0,
+        2e5,
+        1e6,
+        1e300,
+        -1e300,
+        f64::NAN,
+        1e-300,
+        3.0,
+    ];
     let outs = [vr::FX, vr::FY, vr::MX, vr::MY, vr::MZ, vr::MUX, vr::MUY];
     let mut seq = 0usize;
     let n = count();
@@ -372,7 +532,15 @@ fn fuzz_fmu_calls() {
     fuzz("fmu", 6, &seeds, |_| unsafe {
         let mut r = rng(1000 + seq as u64);
         seq += 1;
-        let c = fmi2Instantiate(name.as_ptr(), FMI2_CO_SIMULATION, guid.as_ptr(), res.as_ptr(), std::ptr::null(), 0, 0);
+        let c = fmi2Instantiate(
+            name.as_ptr(),
+            FMI2_CO_SIMULATION,
+            guid.as_ptr(),
+            res.as_ptr(),
+            std::ptr::null(),
+            0,
+            0,
+        );
         if c.is_null() {
             return Err("instantiate failed".into());
         }
@@ -397,7 +565,12 @@ fn fuzz_fmu_calls() {
             match r.gen_range(0..10) {
                 0..=3 => {
                     let i = r.gen_range(0..inputs.len());
-                    let x = pool[r.gen_range(0..pool.len())] * if r.gen_bool(0.3) { r.gen_range(0.5..1.5) } else { 1.0 };
+                    let x = pool[r.gen_range(0..pool.len())]
+                        * if r.gen_bool(0.3) {
+                            r.gen_range(0.5..1.5)
+                        } else {
+                            1.0
+                        };
                     fmi2SetReal(c, [inputs[i]].as_ptr(), 1, [x].as_ptr());
                 }
                 4..=6 => {

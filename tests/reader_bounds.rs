@@ -38,15 +38,30 @@ fn run(args: &[&str]) -> (i32, u64, String) {
         "tyrekit {args:?} was killed by signal {} (crash); stderr: {stderr}",
         libc::WTERMSIG(status)
     );
-    (libc::WEXITSTATUS(status), ru.ru_maxrss as u64 * 1024, stderr)
+    (
+        libc::WEXITSTATUS(status),
+        ru.ru_maxrss as u64 * 1024,
+        stderr,
+    )
 }
 
 fn check(what: &str, args: &[&str], must_fail: bool) -> u64 {
     let (code, rss, err) = run(args);
-    eprintln!("{what}: exit {code}, peak RSS {} MiB; {}", rss >> 20, err.lines().last().unwrap_or(""));
-    assert!(rss <= MEMORY_BOUND, "{what}: peak memory {} MiB above the bound", rss >> 20);
+    eprintln!(
+        "{what}: exit {code}, peak RSS {} MiB; {}",
+        rss >> 20,
+        err.lines().last().unwrap_or("")
+    );
+    assert!(
+        rss <= MEMORY_BOUND,
+        "{what}: peak memory {} MiB above the bound",
+        rss >> 20
+    );
     if must_fail {
-        assert!(code != 0 && err.contains("error"), "{what}: expected a clear error, got exit {code}: {err}");
+        assert!(
+            code != 0 && err.contains("error"),
+            "{what}: expected a clear error, got exit {code}: {err}"
+        );
     }
     rss
 }
@@ -144,7 +159,11 @@ fn mat_decompression_bomb_is_refused_early() {
     let mut f = header();
     tag(&mut f, 15, zb.len());
     f.extend(zb);
-    eprintln!("bomb .mat: {} bytes, inflates to {} MB", f.len(), n * 8 >> 20);
+    eprintln!(
+        "bomb .mat: {} bytes, inflates to {} MB",
+        f.len(),
+        n * 8 >> 20
+    );
     let p = write("bomb.mat", &f);
     let rss = check("mat bomb", &["data", "summary", s(&p)], true);
     // Refused at 64 x the file size: far below the 960 MB it declares.
@@ -158,17 +177,39 @@ fn tir_of_50mb_duplicated_keys() {
         t.extend_from_slice(b"PDX1 = 1\nXKEY = 2\n");
     }
     let p = write("dup.tir", &t);
-    let input = write("in.csv", b"Fz,kappa,alpha,gamma,phit,Vx,P,omega\n4000,0,0,0,0,10,,\n");
+    let input = write(
+        "in.csv",
+        b"Fz,kappa,alpha,gamma,phit,Vx,P,omega\n4000,0,0,0,0,10,,\n",
+    );
     let out = dir().join("out.csv");
-    check("tir 50 MB duplicated keys", &["eval", "--tir", s(&p), "--input", s(&input), "--output", s(&out)], true);
+    check(
+        "tir 50 MB duplicated keys",
+        &[
+            "eval",
+            "--tir",
+            s(&p),
+            "--input",
+            s(&input),
+            "--output",
+            s(&out),
+        ],
+        true,
+    );
     // At the reader's size limit: read in linear time with capped warnings.
     let t2 = &t[..tyrekit::tir::MAX_TIR_BYTES - 100];
     let t0 = std::time::Instant::now();
     let r = tyrekit::tir::TyreParams::from_bytes(t2, "dup2");
     let secs = t0.elapsed().as_secs_f64();
-    eprintln!("tir {} MiB of duplicates: read in {secs:.2} s", t2.len() >> 20);
+    eprintln!(
+        "tir {} MiB of duplicates: read in {secs:.2} s",
+        t2.len() >> 20
+    );
     let w = r.expect("duplicates read").warnings;
-    assert!(w.len() <= tyrekit::tir::read::MAX_WARNINGS + 5, "{} warnings kept", w.len());
+    assert!(
+        w.len() <= tyrekit::tir::read::MAX_WARNINGS + 5,
+        "{} warnings kept",
+        w.len()
+    );
     assert!(secs < 10.0, "{secs} s");
 }
 
@@ -188,8 +229,16 @@ fn recordings_of_50mb() {
         "0,1,2,3,0,0,0,0,1,2,3,4,5,6\n",
     );
     check("csv 50 MB", &["data", "summary", s(&csv)], false);
-    let garbage = numbers_file("garbage.csv", "a,b\n", "1,2,3,4,5,6,7,8,9,0,1,2,3,4,5,6,7\n");
-    check("csv 50 MB ragged rows", &["data", "summary", s(&garbage)], true);
+    let garbage = numbers_file(
+        "garbage.csv",
+        "a,b\n",
+        "1,2,3,4,5,6,7,8,9,0,1,2,3,4,5,6,7\n",
+    );
+    check(
+        "csv 50 MB ragged rows",
+        &["data", "summary", s(&garbage)],
+        true,
+    );
     let dat = numbers_file(
         "big.dat",
         "ET V N SA IA RL RE P FX FY FZ MX MZ SR\ns kph rpm deg deg cm cm kPa N N N N-m N-m none\n",
@@ -202,11 +251,19 @@ fn recordings_of_50mb() {
         "0 10 4000\n",
     );
     // 5 million rows of 10 bytes: refused by the row limit.
-    check("tdx 50 MB (5.2 M short rows)", &["data", "summary", s(&tdx)], true);
+    check(
+        "tdx 50 MB (5.2 M short rows)",
+        &["data", "summary", s(&tdx)],
+        true,
+    );
     // A TTC .mat of 14 double channels, 450 000 rows (50 MB, uncompressed).
     let n = 450_000;
-    let names = ["ET", "V", "N", "SA", "IA", "RL", "RE", "P", "FX", "FY", "FZ", "MX", "MZ", "SR"];
-    let units = ["s", "kph", "rpm", "deg", "deg", "cm", "cm", "kPa", "N", "N", "N", "N-m", "N-m", "none"];
+    let names = [
+        "ET", "V", "N", "SA", "IA", "RL", "RE", "P", "FX", "FY", "FZ", "MX", "MZ", "SR",
+    ];
+    let units = [
+        "s", "kph", "rpm", "deg", "deg", "cm", "cm", "kPa", "N", "N", "N", "N-m", "N-m", "none",
+    ];
     let t = tyrekit::data::RawTable {
         columns: names
             .iter()
@@ -214,7 +271,15 @@ fn recordings_of_50mb() {
             .map(|(k, c)| tyrekit::data::RawColumn {
                 name: c.to_string(),
                 unit: Some(units[k].to_string()),
-                data: (0..n).map(|i| if *c == "FZ" { -1000.0 } else { (i % 100) as f64 + k as f64 }).collect(),
+                data: (0..n)
+                    .map(|i| {
+                        if *c == "FZ" {
+                            -1000.0
+                        } else {
+                            (i % 100) as f64 + k as f64
+                        }
+                    })
+                    .collect(),
             })
             .collect(),
         ..Default::default()

@@ -25,7 +25,9 @@ fn lugre_is_bounded_by_friction_under_slip_reversals() {
     for i in 0..20_000 {
         // 0.5 ms per half period: 5 steps of 0.1 ms.
         let k = if (i / 5) % 2 == 0 { 0.2 } else { -0.2 };
-        let o = m.step(&tyre, &vel(vx, 0.0, vx * (1.0 + k) / re), dt).unwrap();
+        let o = m
+            .step(&tyre, &vel(vx, 0.0, vx * (1.0 + k) / re), dt)
+            .unwrap();
         mux = o.mux;
         worst = worst.max(o.fx.abs() / (o.mux * FZ));
         assert!(o.fx.is_finite() && o.fy.is_finite());
@@ -43,14 +45,26 @@ fn lugre_is_bounded_by_friction_under_slip_reversals() {
 #[test]
 fn steady_turn_slip_is_defined_at_standstill() {
     let tyre = Tyre::builtin();
-    for kind in [TransientKind::Steady, TransientKind::Relaxation, TransientKind::LuGre] {
+    for kind in [
+        TransientKind::Steady,
+        TransientKind::Relaxation,
+        TransientKind::LuGre,
+    ] {
         let mut m = TransientModel::new(TransientConfig {
             kind,
             input_mode: InputMode::Velocities,
             use_mode: UseMode::from_code(112).unwrap(),
         });
-        for (vy, omega, phit) in [(0.0, 0.0, 0.0), (0.0, 0.0, 0.5), (0.1, 0.0, -2.0), (0.0, 1.0, 1.0)] {
-            let inp = WheelInput { phit, ..vel(0.0, vy, omega) };
+        for (vy, omega, phit) in [
+            (0.0, 0.0, 0.0),
+            (0.0, 0.0, 0.5),
+            (0.1, 0.0, -2.0),
+            (0.0, 1.0, 1.0),
+        ] {
+            let inp = WheelInput {
+                phit,
+                ..vel(0.0, vy, omega)
+            };
             let o = m
                 .step(&tyre, &inp, 1e-3)
                 .unwrap_or_else(|e| panic!("{kind:?} vy={vy} omega={omega} phit={phit}: {e}"));
@@ -58,7 +72,10 @@ fn steady_turn_slip_is_defined_at_standstill() {
                 assert!(v.is_finite(), "{kind:?}: {o:?}");
             }
             // Standing still, a tyre transmits at most friction (μ ≈ 1 here).
-            assert!(o.fx.abs() <= 1.5 * FZ && o.fy.abs() <= 1.5 * FZ, "{kind:?}: {o:?}");
+            assert!(
+                o.fx.abs() <= 1.5 * FZ && o.fy.abs() <= 1.5 * FZ,
+                "{kind:?}: {o:?}"
+            );
         }
     }
 }
@@ -77,7 +94,10 @@ fn relaxation_recovers_from_an_extreme_step() {
                 input_mode: InputMode::Velocities,
                 use_mode: UseMode::default(),
             },
-            tyrekit::transient::TransientOptions { nonlinear, ..Default::default() },
+            tyrekit::transient::TransientOptions {
+                nonlinear,
+                ..Default::default()
+            },
         );
         let vx = 10.0;
         let w = vx / common::re(&tyre, vx);
@@ -92,8 +112,15 @@ fn relaxation_recovers_from_an_extreme_step() {
             last = Some(m.step(&tyre, &vel(vx, 0.0, w), 1e-3).unwrap());
         }
         let o = last.unwrap();
-        assert!(o.fy.abs() < 0.02 * FZ, "nonlinear={nonlinear}: Fy = {} after 1 s", o.fy);
-        assert!(o.fx.abs() < 0.05 * FZ, "nonlinear={nonlinear}: Fx = {} after 1 s", o.fx);
+        assert!(
+            o.fy.abs() < 0.02 * FZ,
+            "nonlinear={nonlinear}: Fy = {} after 1 s",
+            o.fy
+        );
+        assert!(
+            o.fx.abs() < 0.05 * FZ,
+            "nonlinear={nonlinear}: Fx = {} after 1 s",
+            o.fx
+        );
     }
 }
-

@@ -65,17 +65,29 @@ fn shared_files_load_except_harty() {
 
 #[test]
 fn hoosier_qsx13_loads_with_an_mx_warning() {
-    let Some(d) = tir_common::tir_dir() else { return };
+    let Some(d) = tir_common::tir_dir() else {
+        return;
+    };
     let t = Tyre::from_file(&d.join("Hoosier-20.5x7x13R25B-ISO.TIR")).unwrap();
     assert!(
-        t.warnings().iter().any(|w| w.starts_with("validation: Mx") && w.contains("QSX")),
+        t.warnings()
+            .iter()
+            .any(|w| w.starts_with("validation: Mx") && w.contains("QSX")),
         "{:#?}",
         t.warnings()
     );
     // The clean reference tyres carry no validation doubt.
-    for f in ["PacejkaBook_Defaults.tir", "MagicFormula61_Parameters.tir", "FSAE_Defaults.tir"] {
+    for f in [
+        "PacejkaBook_Defaults.tir",
+        "MagicFormula61_Parameters.tir",
+        "FSAE_Defaults.tir",
+    ] {
         let t = Tyre::from_file(&d.join(f)).unwrap();
-        let v: Vec<_> = t.warnings().iter().filter(|w| w.starts_with("validation")).collect();
+        let v: Vec<_> = t
+            .warnings()
+            .iter()
+            .filter(|w| w.starts_with("validation"))
+            .collect();
         assert!(v.is_empty(), "{f}: {v:#?}");
     }
 }
@@ -90,24 +102,45 @@ fn keys_the_model_divides_by_are_refused_when_zero_or_negative() {
         ("LFZO", "0"),
         ("FNOMIN", "-4000"),
     ] {
-        let e = load(key, &format!("{key} = {bad}")).err().unwrap_or_else(|| panic!("{key} = {bad} loaded"));
-        assert!(e.contains(key) && e.contains("refused"), "{key} = {bad}: {e}");
+        let e = load(key, &format!("{key} = {bad}"))
+            .err()
+            .unwrap_or_else(|| panic!("{key} = {bad} loaded"));
+        assert!(
+            e.contains(key) && e.contains("refused"),
+            "{key} = {bad}: {e}"
+        );
     }
 }
 
 #[test]
 fn wrong_units_are_refused_or_warned() {
     // LENGTH = 'mm' on a file written in metres: R0 = 0.3 mm, no tyre.
-    let e = load("LENGTH", "LENGTH = 'mm'").err().expect("mm radius loaded");
-    assert!(e.contains("UNLOADED_RADIUS") && e.contains("[UNITS]"), "{e}");
+    let e = load("LENGTH", "LENGTH = 'mm'")
+        .err()
+        .expect("mm radius loaded");
+    assert!(
+        e.contains("UNLOADED_RADIUS") && e.contains("[UNITS]"),
+        "{e}"
+    );
     // TIME = 'hour': LONGVL = 16.7 m/h; loads (the model evaluates) but says so.
     let t = load("TIME", "TIME = 'hour'").expect("TIME = hour must evaluate");
-    assert!(t.warnings().iter().any(|w| w.contains("LONGVL")), "{:#?}", t.warnings());
+    assert!(
+        t.warnings().iter().any(|w| w.contains("LONGVL")),
+        "{:#?}",
+        t.warnings()
+    );
     // My there is absurd (Vx/LONGVL ~ 1e4): it must be among the warnings.
-    let x = MfInput { fz: 4000.0, vx: 30.0, ..Default::default() };
+    let x = MfInput {
+        fz: 4000.0,
+        vx: 30.0,
+        ..Default::default()
+    };
     let my = t.evaluate(&x, UseMode::default()).my;
     if my.abs() > 10.0 * 4000.0 * 0.3135 {
-        assert!(t.warnings().iter().any(|w| w.starts_with("validation: My")), "My = {my}");
+        assert!(
+            t.warnings().iter().any(|w| w.starts_with("validation: My")),
+            "My = {my}"
+        );
     }
 }
 
@@ -116,8 +149,19 @@ fn presmax_zero_is_refused_or_finite() {
     match load("PRESMAX", "PRESMAX = 0") {
         Err(e) => assert!(e.contains("refused"), "{e}"),
         Ok(t) => {
-            let o = t.evaluate(&MfInput { fz: 4000.0, vx: 16.7, alpha: 0.05, ..Default::default() }, UseMode::default());
-            assert!(o.fx.is_finite() && o.fy.is_finite() && o.mz.is_finite(), "{o:?}");
+            let o = t.evaluate(
+                &MfInput {
+                    fz: 4000.0,
+                    vx: 16.7,
+                    alpha: 0.05,
+                    ..Default::default()
+                },
+                UseMode::default(),
+            );
+            assert!(
+                o.fx.is_finite() && o.fy.is_finite() && o.mz.is_finite(),
+                "{o:?}"
+            );
         }
     }
 }
@@ -125,7 +169,11 @@ fn presmax_zero_is_refused_or_finite() {
 /// Absurd coefficients load (the model evaluates) but never silently.
 #[test]
 fn absurd_coefficients_load_with_a_warning() {
-    for (key, line) in [("QSX1", "QSX1 = 1e6"), ("PDX1", "PDX1 = 1e3"), ("QSY1", "QSY1 = 1e4")] {
+    for (key, line) in [
+        ("QSX1", "QSX1 = 1e6"),
+        ("PDX1", "PDX1 = 1e3"),
+        ("QSY1", "QSY1 = 1e4"),
+    ] {
         let t = load(key, line).unwrap_or_else(|e| panic!("{line}: {e}"));
         assert!(
             t.warnings().iter().any(|w| w.starts_with("validation")),
@@ -137,7 +185,10 @@ fn absurd_coefficients_load_with_a_warning() {
 
 /// `tyrekit eval --tir TIR` on one input row: (success, stderr).
 fn eval(tir: &std::path::Path) -> (bool, String) {
-    let input = write("in.csv", "Fz,kappa,alpha,gamma,phit,Vx,P,omega\n4000,0,0.05,0,0,16.7,,\n");
+    let input = write(
+        "in.csv",
+        "Fz,kappa,alpha,gamma,phit,Vx,P,omega\n4000,0,0.05,0,0,16.7,,\n",
+    );
     let out = write("out.csv", "");
     let r = std::process::Command::new(env!("CARGO_BIN_EXE_tyrekit"))
         .args(["eval", "--tir"])
@@ -148,7 +199,10 @@ fn eval(tir: &std::path::Path) -> (bool, String) {
         .arg(&out)
         .output()
         .unwrap();
-    (r.status.success(), String::from_utf8_lossy(&r.stderr).into_owned())
+    (
+        r.status.success(),
+        String::from_utf8_lossy(&r.stderr).into_owned(),
+    )
 }
 
 /// The CLI shows the reader's and the validation's warnings on stderr, and

@@ -93,11 +93,7 @@ pub struct ReadArgs {
 impl ReadArgs {
     /// Loader options from the flags.
     pub fn options(&self) -> Result<LoadOptions> {
-        let tyre = self
-            .tir
-            .as_ref()
-            .map(|t| super::load_tyre(t))
-            .transpose()?;
+        let tyre = self.tir.as_ref().map(|t| super::load_tyre(t)).transpose()?;
         let mut o = self.rec.options(tyre.as_ref(), "--tir")?;
         if self.compute_kappa {
             o.kappa = data::KappaSource::Computed;

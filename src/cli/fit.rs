@@ -176,7 +176,10 @@ pub fn run(args: Args) -> Result<()> {
     // it is written (a refusal is an error; doubts are shown).
     let checked = Tyre::checked(res.tyre.clone())?;
     let n_read = res.tyre.warnings.len();
-    super::show_warnings(&args.out.display().to_string(), &checked.warnings()[n_read..]);
+    super::show_warnings(
+        &args.out.display().to_string(),
+        &checked.warnings()[n_read..],
+    );
     for s in &res.skipped {
         eprintln!("tyrekit fit: stage skipped: {s}");
     }

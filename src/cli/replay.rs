@@ -43,7 +43,10 @@ pub fn run(a: Args) -> Result<()> {
             a.use_mode
         ))
     })?;
-    let from_file = a.transient.trim().eq_ignore_ascii_case(TransientKind::FROM_FILE);
+    let from_file = a
+        .transient
+        .trim()
+        .eq_ignore_ascii_case(TransientKind::FROM_FILE);
     if !from_file && TransientKind::parse(&a.transient).is_none() {
         return Err(Error::Input(format!(
             "--transient {}: expected file (as the tyre file says), steady, relaxation or lugre",

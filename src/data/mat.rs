@@ -243,7 +243,11 @@ pub fn read(bytes: &[u8]) -> R<Vec<(String, MatValue)>> {
             "trailing partial element (file truncated)",
         );
     }
-    let cap = bytes.len().saturating_mul(INFLATE_RATIO).saturating_add(1 << 20).min(MAX_INFLATED);
+    let cap = bytes
+        .len()
+        .saturating_mul(INFLATE_RATIO)
+        .saturating_add(1 << 20)
+        .min(MAX_INFLATED);
     let budget = Budget {
         inflated: cap.into(),
         values: MAX_VALUES.into(),
@@ -271,13 +275,10 @@ pub fn read(bytes: &[u8]) -> R<Vec<(String, MatValue)>> {
                 ),
             );
         }
-        inflated
-            .map_err(|e| MatError {
-                location: loc.clone(),
-                message: format!(
-                    "zlib stream of a compressed variable is corrupt or truncated: {e}"
-                ),
-            })?;
+        inflated.map_err(|e| MatError {
+            location: loc.clone(),
+            message: format!("zlib stream of a compressed variable is corrupt or truncated: {e}"),
+        })?;
         let (ty2, n2, hdr2, _) = tag(&dec, 0, big, loc)?;
         if ty2 != mi::MATRIX {
             return err(
@@ -451,7 +452,13 @@ fn to_text(ty: u32, d: &[u8], big: bool, loc: &str) -> R<Vec<char>> {
 }
 
 /// Decode the body of a miMATRIX element: (name, value).
-fn matrix(body: &[u8], big: bool, loc: &str, depth: usize, budget: &Budget) -> R<(String, MatValue)> {
+fn matrix(
+    body: &[u8],
+    big: bool,
+    loc: &str,
+    depth: usize,
+    budget: &Budget,
+) -> R<(String, MatValue)> {
     if depth > MAX_DEPTH {
         return err(
             loc,

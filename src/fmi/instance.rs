@@ -265,8 +265,8 @@ pub fn load_tyre(resources: &Path, key: &str) -> Result<Loaded, String> {
     // as tyre_file is refused at once), then the one validation of a tyre.
     let fail = |e: crate::Error| format!("cannot load tyre property file {}: {e}", path.display());
     let bytes = crate::tir::read_file(&path).map_err(fail)?;
-    let params = crate::tir::TyreParams::from_bytes(&bytes, &path.display().to_string())
-        .map_err(fail)?;
+    let params =
+        crate::tir::TyreParams::from_bytes(&bytes, &path.display().to_string()).map_err(fail)?;
     let tyre = Tyre::checked(params).map_err(fail)?;
     Ok(Loaded {
         tyre: Arc::new(tyre),
@@ -335,7 +335,9 @@ pub const FZ_LIMIT_FACTOR: f64 = 10.0;
 /// The tyre-relative load limit (N) of [`FZ_LIMIT_FACTOR`].
 pub fn fz_limit(tyre: &Tyre) -> f64 {
     let p = &tyre.params().p;
-    FZ_LIMIT_FACTOR * p.fnomin.max(if p.fzmax.is_finite() { p.fzmax } else { 0.0 })
+    FZ_LIMIT_FACTOR
+        * p.fnomin
+            .max(if p.fzmax.is_finite() { p.fzmax } else { 0.0 })
 }
 
 /// The lowest inflation pressure (Pa) accepted besides the sentinel 0 (=
@@ -354,7 +356,10 @@ fn input_problem(slot: usize, x: f64) -> Option<String> {
             "is below {P_MIN} Pa (0.1 bar, a flat tyre) and not 0 (= the file's INFLPRES)"
         ));
     }
-    let (lo, hi) = REAL_LIMITS.get(slot).copied().unwrap_or((f64::NEG_INFINITY, f64::INFINITY));
+    let (lo, hi) = REAL_LIMITS
+        .get(slot)
+        .copied()
+        .unwrap_or((f64::NEG_INFINITY, f64::INFINITY));
     if !(lo..=hi).contains(&x) {
         return Some(format!(
             "is outside its physical range [{lo}, {hi}] (min/max in modelDescription.xml)"
@@ -517,7 +522,10 @@ fn all_finite(o: &WheelOutput) -> bool {
 fn input_error(r: &[f64], tyre: &Tyre) -> String {
     for (slot, name) in INPUTS {
         if let Some(why) = input_problem(slot, r[slot]) {
-            return format!("input {name} = {} {why}; step refused, nothing changed", r[slot]);
+            return format!(
+                "input {name} = {} {why}; step refused, nothing changed",
+                r[slot]
+            );
         }
     }
     let lim = fz_limit(tyre);

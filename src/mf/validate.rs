@@ -170,8 +170,16 @@ fn first_non_finite(o: &MfOutput) -> Option<(&'static str, f64)> {
 /// Five loads over the file's range: 0.25, 0.5, 1, 1.5, 2 × FNOMIN, clipped
 /// to FZMIN..FZMAX when those are sensible.
 fn loads(fnomin: f64, fzmin: f64, fzmax: f64) -> [f64; 5] {
-    let lo = if fzmin.is_finite() && fzmin > 0.0 { fzmin } else { 0.0 };
-    let hi = if fzmax.is_finite() && fzmax > lo { fzmax } else { f64::INFINITY };
+    let lo = if fzmin.is_finite() && fzmin > 0.0 {
+        fzmin
+    } else {
+        0.0
+    };
+    let hi = if fzmax.is_finite() && fzmax > lo {
+        fzmax
+    } else {
+        f64::INFINITY
+    };
     [0.25, 0.5, 1.0, 1.5, 2.0].map(|f| (f * fnomin).clamp(lo.min(fnomin), hi.max(fnomin)))
 }
 
@@ -257,7 +265,11 @@ impl Worst {
         }
         for (i, e) in self.excess.iter().enumerate() {
             if let Some((_, v, b, x)) = e {
-                let what = if i < 2 { "Fz·max(1, mu)" } else { "Fz·R0·max(1, mu)" };
+                let what = if i < 2 {
+                    "Fz·max(1, mu)"
+                } else {
+                    "Fz·R0·max(1, mu)"
+                };
                 let f = if i < 2 { FORCE_FACTOR } else { MOMENT_FACTOR };
                 w.push(format!(
                     "validation: {} = {v:.4e} at {} exceeds {f}·{what} = {b:.4e}, \

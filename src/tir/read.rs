@@ -235,7 +235,9 @@ fn cap_warnings(w: &mut Vec<String>) {
     if w.len() > MAX_WARNINGS {
         let more = w.len() - MAX_WARNINGS;
         w.truncate(MAX_WARNINGS);
-        w.push(format!("… and {more} more warnings (only the first {MAX_WARNINGS} are listed)"));
+        w.push(format!(
+            "… and {more} more warnings (only the first {MAX_WARNINGS} are listed)"
+        ));
         w.shrink_to_fit();
     }
 }

@@ -345,7 +345,8 @@ fn elastoplastic(z: f64, zss: f64, vr: f64, beta: f64) -> f64 {
 }
 
 /// LuGre forces never exceed this multiple of the friction limit
-/// max(μ_i·Fz, |F_i,MF|) per direction (see [`step`]).
+/// max(μ_i·Fz, |F_i,MF|) per direction (see [`step`]); μ_i is the Stribeck
+/// peak max(μs, μc) with the own Stribeck curve, else the MF's μ_i·max(1, μs).
 pub const LUGRE_FRICTION_MARGIN: f64 = 1.05;
 
 /// One LuGre step (see the module docs); updates slots 0, 1 of `st`.
@@ -481,8 +482,21 @@ pub(crate) fn step(c: &StepCtx, p: &LuGreParams, st: &mut TransientState, dt: f6
             f64::INFINITY
         }
     };
-    let fx = fx.clamp(-lim(c.props.mux, o.fx), lim(c.props.mux, o.fx));
-    let fy = fy.clamp(-lim(c.props.muy, o.fy), lim(c.props.muy, o.fy));
+    // The friction coefficient the bristles can reach: the Stribeck curve's
+    // peak with its own parameters, or the MF's μ raised by the static
+    // factor μs where the MF mode applies one (both set the steady state).
+    let (mux, muy) = match p.friction {
+        LuGreFriction::Stribeck => {
+            let m = p.mu_s.abs().max(p.mu_c.abs());
+            (m, m)
+        }
+        LuGreFriction::MagicFormula => {
+            let k = p.mu_s.abs().max(1.0);
+            (k * c.props.mux, k * c.props.muy)
+        }
+    };
+    let fx = fx.clamp(-lim(mux, o.fx), lim(mux, o.fx));
+    let fy = fy.clamp(-lim(muy, o.fy), lim(muy, o.fy));
     // Aligning moment: the MF's, scaled by the ratio of dynamic to steady Fy
     // (the pneumatic trail of the steady state; bounded to stay sane when
     // the steady Fy is near zero).

@@ -17,8 +17,7 @@ mod devset;
 use devset::{Answer, Figure};
 use std::path::Path;
 use std::process::Command;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Mutex, OnceLock};
+use std::sync::OnceLock;
 
 /// Issue #14's acceptance: pure-slip figures ≤ 1.15 × baseline, all-row
 /// figures ≤ 1.5 × (Fx of cornering-only programmes excepted: the answer's
@@ -89,30 +88,7 @@ fn run(a: &Answer, dir: &Path) -> Outcome {
 fn outcomes() -> Option<&'static Vec<Outcome>> {
     static CELL: OnceLock<Option<Vec<Outcome>>> = OnceLock::new();
     CELL.get_or_init(|| {
-        let dir = common::shared().join("data/diagnose-dev");
-        let Some(answers) = devset::answers(&dir) else {
-            eprintln!(
-                "SKIP devset_fit: {} not found (the shared dev set)",
-                dir.display()
-            );
-            return None;
-        };
-        let work = Path::new(env!("CARGO_TARGET_TMPDIR")).join("devset_fit");
-        std::fs::create_dir_all(&work).expect("work dir");
-        let next = AtomicUsize::new(0);
-        let done = Mutex::new(Vec::new());
-        std::thread::scope(|s| {
-            for _ in 0..2 {
-                s.spawn(|| loop {
-                    let i = next.fetch_add(1, Ordering::SeqCst);
-                    let Some(a) = answers.get(i) else { break };
-                    let o = run(a, &work);
-                    done.lock().unwrap().push(o);
-                });
-            }
-        });
-        let mut v = done.into_inner().unwrap();
-        v.sort_by(|a, b| a.answer.name.cmp(&b.answer.name));
+        let v = devset::run_all("devset_fit", |a, work, _dir| run(a, work))?;
         print_table(&v);
         Some(v)
     })

@@ -27,8 +27,7 @@ mod devset;
 use devset::Answer;
 use std::path::Path;
 use std::process::Command;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Mutex, OnceLock};
+use std::sync::OnceLock;
 use tyrekit::mf::Tyre;
 use tyrekit::residual::{write_csv, ReplayOptions};
 use tyrekit::transient::TransientKind;
@@ -161,30 +160,7 @@ fn run(a: &Answer, dir: &Path, data: &Path) -> Outcome {
 fn outcomes() -> Option<&'static Vec<Outcome>> {
     static CELL: OnceLock<Option<Vec<Outcome>>> = OnceLock::new();
     CELL.get_or_init(|| {
-        let dir = common::shared().join("data/diagnose-dev");
-        let Some(answers) = devset::answers(&dir) else {
-            eprintln!(
-                "SKIP diagnose_devset: {} not found (the shared dev set)",
-                dir.display()
-            );
-            return None;
-        };
-        let work = Path::new(env!("CARGO_TARGET_TMPDIR")).join("diagnose_devset");
-        std::fs::create_dir_all(&work).expect("work dir");
-        let next = AtomicUsize::new(0);
-        let done = Mutex::new(Vec::new());
-        std::thread::scope(|s| {
-            for _ in 0..2 {
-                s.spawn(|| loop {
-                    let i = next.fetch_add(1, Ordering::SeqCst);
-                    let Some(a) = answers.get(i) else { break };
-                    let o = run(a, &work, &dir);
-                    done.lock().unwrap().push(o);
-                });
-            }
-        });
-        let mut v: Vec<Outcome> = done.into_inner().unwrap();
-        v.sort_by(|a, b| a.name.cmp(&b.name));
+        let v = devset::run_all("diagnose_devset", |a, work, dir| run(a, work, dir))?;
         print_table(&v);
         Some(v)
     })

@@ -269,3 +269,39 @@ pub fn figures(a: &Answer, raw: &Raw, sim: &HashMap<i64, [f64; 3]>) -> (Vec<Figu
     out.sort_by(|x, y| (x.group != "pure", &x.channel).cmp(&(y.group != "pure", &y.channel)));
     (out, missing)
 }
+
+/// Run `job(answer, work dir, dev-set dir)` over every dev-set recording, two
+/// at a time (the CI machine's cores), results sorted by recording name. None,
+/// after a SKIP line naming `test`, when the shared dev set is absent.
+pub fn run_all<T: Send>(
+    test: &str,
+    job: impl Fn(&Answer, &Path, &Path) -> T + Sync,
+) -> Option<Vec<T>> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::Mutex;
+    let dir = crate::common::shared().join("data/diagnose-dev");
+    let Some(answers) = answers(&dir) else {
+        eprintln!(
+            "SKIP {test}: {} not found (the shared dev set)",
+            dir.display()
+        );
+        return None;
+    };
+    let work = Path::new(env!("CARGO_TARGET_TMPDIR")).join(test);
+    std::fs::create_dir_all(&work).expect("work dir");
+    let next = AtomicUsize::new(0);
+    let done = Mutex::new(Vec::new());
+    std::thread::scope(|s| {
+        for _ in 0..2 {
+            s.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::SeqCst);
+                let Some(a) = answers.get(i) else { break };
+                let o = job(a, &work, &dir);
+                done.lock().unwrap().push((a.name.clone(), o));
+            });
+        }
+    });
+    let mut v = done.into_inner().unwrap();
+    v.sort_by(|a, b| a.0.cmp(&b.0));
+    Some(v.into_iter().map(|(_, o)| o).collect())
+}

@@ -69,6 +69,13 @@ pub fn load_all(paths: &[PathBuf], o: &LoadOptions, cmd: &str) -> Result<Vec<dat
         for r in &l.report.rejected {
             eprintln!("tyrekit {cmd}: warning: {}: {r}", p.display());
         }
+        if !l.report.slip_reference.is_empty() {
+            eprintln!(
+                "tyrekit {cmd}: {}: slip reference {}",
+                p.display(),
+                l.report.slip_reference
+            );
+        }
         out.push(l);
     }
     Ok(out)
@@ -293,6 +300,9 @@ pub fn summary_text(l: &Loaded) -> String {
         let _ = writeln!(s, "extra:    {}", ex.join(" "));
     }
     let _ = writeln!(s, "kappa:    {}", p.kappa);
+    if !p.slip_reference.is_empty() {
+        let _ = writeln!(s, "slip ref: {}", p.slip_reference);
+    }
     match &p.warmup {
         Some(w) => {
             let _ = writeln!(

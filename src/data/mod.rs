@@ -17,6 +17,7 @@ pub mod mat;
 pub mod plot;
 pub mod sanity;
 pub mod slip;
+pub mod slip_reference;
 pub mod structure;
 pub mod tdx;
 pub mod ttc;
@@ -33,7 +34,9 @@ use units::Dim;
 pub struct Sample {
     /// Time (s).
     pub time: f64,
-    /// Longitudinal speed of the wheel centre (m/s): V·cos α for rigs that record the road speed V.
+    /// Longitudinal speed of the wheel centre (m/s): for rigs that record only
+    /// the belt speed V, V·cos α or V as the recording's slip reference says
+    /// ([`slip_reference`]).
     pub vx: f64,
     /// Wheel spin (rad/s).
     pub omega: f64,
@@ -387,6 +390,9 @@ pub struct LoadReport {
     pub extra_units: Vec<(String, String)>,
     /// How κ was obtained.
     pub kappa: String,
+    /// Which speed Vx (and so κ) refers to when only the belt speed is
+    /// recorded, with the evidence ([`slip_reference`]); empty otherwise.
+    pub slip_reference: String,
     /// The warm-up cut, if any.
     pub warmup: Option<structure::WarmupCut>,
     /// Other remarks (unknown units of extra channels, time going backwards …).
@@ -845,6 +851,27 @@ pub fn from_raw(raw: RawTable, format: Format, file: &str, opts: &LoadOptions) -
     sanity::check_wheel_speed(&mut samples, &mut channels, &mut report);
     sanity::check_radii(&samples, &mut extra, &mut report);
     sanity::check_pinned_slip(&mut samples, &mut channels, &mut extra, &mut report);
+    // Belt speed only: which speed the tyre's slip refers to is read from the
+    // free-rolling samples ([`slip_reference`]); Vx follows it.
+    if let (None, Some(v)) = (get(Ch::Vx), get(Ch::Speed)) {
+        let evidence = channels
+            .iter()
+            .any(|c| c == "omega")
+            .then(|| slip_reference::detect(&samples, v))
+            .flatten();
+        report.slip_reference = match evidence {
+            Some(e) => {
+                for (s, &vi) in samples.iter_mut().zip(v) {
+                    s.vx = e.reference.vx(vi, s.alpha);
+                }
+                e.describe()
+            }
+            None => format!(
+                "{} (textbook default: the free-rolling samples cannot decide)",
+                slip_reference::SlipReference::WheelPlane.describe()
+            ),
+        };
+    }
     let has_kappa = channels.iter().any(|c| c == "kappa");
     let rl_col = extra
         .iter()

@@ -1,5 +1,5 @@
 //! slip — longitudinal slip from wheel speed:
-//! κ = Ω·Re/(V·cos α) − 1 = Ω·Re/Vx − 1 (Pacejka, *Tyre and Vehicle
+//! κ = Ω·Re/Vx − 1 with Vx = V·cos α or V per [`super::slip_reference`] (Pacejka, *Tyre and Vehicle
 //! Dynamics*, 3rd ed., eq. 2.9/§2.2: κ = −Vsx/Vx with Vsx = Vx − Ω·Re),
 //! with the effective rolling radius Re chosen by [`ReChoice`].
 //!
@@ -103,7 +103,7 @@ pub fn compute_kappa(
                 s.kappa = kappa(s.omega, a + b * s.fz, s.vx);
             }
             return Some(format!(
-                "κ = Ω·Re/(V·cos α) − 1 with Re(Fz) = {a:.5} m {} {:.3e} m/N·Fz fitted to the recorded RE on free-rolling samples",
+                "κ = Ω·Re/Vx − 1 with Re(Fz) = {a:.5} m {} {:.3e} m/N·Fz fitted to the recorded RE on free-rolling samples",
                 if b < 0.0 { "−" } else { "+" },
                 b.abs()
             ));
@@ -120,7 +120,7 @@ pub fn compute_kappa(
             for (s, r) in samples.iter_mut().zip(re) {
                 s.kappa = kappa(s.omega, *r, s.vx);
             }
-            Some("κ = Ω·Re/(V·cos α) − 1 with the recorded RE (disturbed by slip in drive/brake runs)".into())
+            Some("κ = Ω·Re/Vx − 1 with the recorded RE (disturbed by slip in drive/brake runs)".into())
         }
         ReChoice::Loaded => {
             let rl = rl?;
@@ -128,7 +128,7 @@ pub fn compute_kappa(
                 s.kappa = kappa(s.omega, *r, s.vx);
             }
             Some(
-                "κ = Ω·Rl/(V·cos α) − 1 with the recorded loaded radius (κ biased low by Re − Rl)"
+                "κ = Ω·Rl/Vx − 1 with the recorded loaded radius (κ biased low by Re − Rl)"
                     .into(),
             )
         }
@@ -149,7 +149,7 @@ pub fn compute_kappa(
                 s.kappa = kappa(s.omega, r, s.vx);
             }
             Some(format!(
-                "κ = Ω·Re/(V·cos α) − 1 with the model's Re(Fz) ({})",
+                "κ = Ω·Re/Vx − 1 with the model's Re(Fz) ({})",
                 tyre.params().source
             ))
         }

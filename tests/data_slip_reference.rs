@@ -133,7 +133,10 @@ fn wheel_plane_and_belt_recordings_are_told_apart() {
         assert_eq!(e.reference, SlipReference::Belt, "rr {rr}: {e:?}");
         // Belt: s is the drift alone, ≥ 0 and well below 1 − MARGIN.
         assert!(e.share > -0.1 && e.share < 0.7, "rr {rr}: {e:?}");
-        assert!(e.free_fx_ratio < 0.0, "free-rolling Fx is the rolling resistance: {e:?}");
+        assert!(
+            e.free_fx_ratio < 0.0,
+            "free-rolling Fx is the rolling resistance: {e:?}"
+        );
     }
 }
 
@@ -202,7 +205,13 @@ fn the_loader_derives_kappa_in_the_recordings_own_reference() {
         // 5.5e-3. Tolerance 1e-3: Ω noise 1e-3 averaged over > 50 rows.
         let six = 6f64.to_radians();
         let mean_kappa = |sel: &dyn Fn(&Sample) -> bool| {
-            let k: Vec<f64> = l.recording.samples.iter().filter(|x| sel(x)).map(|x| x.kappa).collect();
+            let k: Vec<f64> = l
+                .recording
+                .samples
+                .iter()
+                .filter(|x| sel(x))
+                .map(|x| x.kappa)
+                .collect();
             assert!(k.len() > 50, "{reference:?}: {} rows", k.len());
             k.iter().sum::<f64>() / k.len() as f64
         };

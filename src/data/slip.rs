@@ -120,17 +120,17 @@ pub fn compute_kappa(
             for (s, r) in samples.iter_mut().zip(re) {
                 s.kappa = kappa(s.omega, *r, s.vx);
             }
-            Some("κ = Ω·Re/Vx − 1 with the recorded RE (disturbed by slip in drive/brake runs)".into())
+            Some(
+                "κ = Ω·Re/Vx − 1 with the recorded RE (disturbed by slip in drive/brake runs)"
+                    .into(),
+            )
         }
         ReChoice::Loaded => {
             let rl = rl?;
             for (s, r) in samples.iter_mut().zip(rl) {
                 s.kappa = kappa(s.omega, *r, s.vx);
             }
-            Some(
-                "κ = Ω·Rl/Vx − 1 with the recorded loaded radius (κ biased low by Re − Rl)"
-                    .into(),
-            )
+            Some("κ = Ω·Rl/Vx − 1 with the recorded loaded radius (κ biased low by Re − Rl)".into())
         }
         ReChoice::Model(tyre) => {
             for s in samples.iter_mut() {

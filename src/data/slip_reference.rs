@@ -113,9 +113,7 @@ pub fn detect(samples: &[Sample], belt_speed: &[f64]) -> Option<SlipReferenceEvi
     let rows: Vec<(f64, f64, f64, f64)> = samples
         .iter()
         .zip(belt_speed)
-        .filter(|(s, &v)| {
-            s.fz > 0.05 * fz_max && v > 1.0 && s.omega > 1.0 && s.alpha.abs() < lim
-        })
+        .filter(|(s, &v)| s.fz > 0.05 * fz_max && v > 1.0 && s.omega > 1.0 && s.alpha.abs() < lim)
         .map(|(s, &v)| {
             (
                 s.fz / fz_max,
@@ -133,9 +131,9 @@ pub fn detect(samples: &[Sample], belt_speed: &[f64]) -> Option<SlipReferenceEvi
     let straight_x = -straight.cos().ln();
     let mut base: Option<[f64; 3]> = None;
     for tol in [f64::INFINITY, 0.05, 0.02] {
-        let pts = rows.iter().filter(|r| {
-            r.1 < straight_x && base.is_none_or(|c| (r.2 - quad(&c, r.0)).abs() < tol)
-        });
+        let pts = rows
+            .iter()
+            .filter(|r| r.1 < straight_x && base.is_none_or(|c| (r.2 - quad(&c, r.0)).abs() < tol));
         base = Some(lsq::<3>(pts.map(|r| ([1.0, r.0, r.0 * r.0], r.2)))?);
     }
     let base = base?;

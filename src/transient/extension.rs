@@ -16,6 +16,19 @@
 //!   (MF 6.1, Pacejka 3rd ed. eq. 4.E7: λμ* = λμ/(1 + λμV·Vs/V0)). The
 //!   steady [`crate::mf::Tyre::evaluate`] does not apply LMUV (MFeval 4.0
 //!   does not either, and no reference file sets it); the step does.
+//! * **sliding-speed friction of general monotone shape**
+//!   (`[SPEED_FRICTION]`, keys `DMU` –, `VC` m/s, `MU0` –):
+//!   s = (1 + MU0)·(1 − DMU·x/(1 + x)), x = Vs/VC — a friction that changes monotonically with the sliding
+//!   speed and levels off at 1 − DMU: the shape of the Stribeck-type
+//!   friction laws, μ(v) = μk + (μs − μk)·g(v/vs) with g falling from 1
+//!   to 0 (the LuGre model's g, Canudas de Wit et al., *IEEE Trans. Autom.
+//!   Control* 40(3), 1995), written as one rational step so it is smooth
+//!   and cheap. It contains the LMUV form above as DMU = 1,
+//!   VC = V0/LMUV, and a saturating fall (DMU < 1) the LMUV form cannot
+//!   give; DMU < 0 is a friction that rises with the sliding speed. MU0
+//!   (default 0) is the friction level at zero sliding speed relative to
+//!   the file's: a Magic Formula fitted to data that carry the speed law
+//!   already holds its average, so the law must be free to turn about it.
 //! * **tread temperature** (`[THERMAL]`, keys `CAPACITY` J/K, `COOLING` W/K,
 //!   `SHARE` –, `MU_T0`, `MU_T1`, `MU_T2` –; temperatures relative to the
 //!   ambient air): a lumped heat balance C·dT/dt = q·P − h·(T − Tamb) with
@@ -52,6 +65,12 @@ pub const SLOT_TEMP: usize = 3;
 pub const LOAD_SECTION: &str = "LOAD_SENSITIVITY";
 /// Keys of [`LOAD_SECTION`].
 pub const LOAD_KEYS: [&str; 3] = ["MU_DFZ1", "MU_DFZ2", "K_DFZ1"];
+/// Section of the sliding-speed friction of general shape.
+pub const SPEED_SECTION: &str = "SPEED_FRICTION";
+/// Keys of [`SPEED_SECTION`]: the friction change at high sliding speed
+/// (DMU, –), the sliding speed of half of it (VC, m/s) and the level at
+/// zero sliding speed (MU0, –, optional, 0).
+pub const SPEED_KEYS: [&str; 3] = ["DMU", "VC", "MU0"];
 /// Section of the tread-temperature model.
 pub const THERMAL_SECTION: &str = "THERMAL";
 /// Keys of [`THERMAL_SECTION`].
@@ -117,6 +136,15 @@ impl Thermal {
     }
 }
 
+/// Friction scale of the sliding-speed law of general shape at sliding
+/// speed `vs` (m/s) without its level: 1 − DMU·x/(1 + x), x = Vs/VC (see
+/// the module docs).
+#[inline]
+pub fn speed_friction(dmu: f64, vc: f64, vs: f64) -> f64 {
+    let x = vs.abs() / vc;
+    1.0 - dmu * x / (1.0 + x)
+}
+
 /// The extension physics of one tyre (None fields: not in the file).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct Extension {
@@ -124,6 +152,8 @@ pub struct Extension {
     pub load: Option<[f64; 3]>,
     /// LMUV and V0 (LONGVL, m/s).
     pub lmuv: Option<(f64, f64)>,
+    /// (DMU, VC m/s, MU0) of [`SPEED_SECTION`].
+    pub speed: Option<(f64, f64, f64)>,
     pub thermal: Option<Thermal>,
     /// Nominal load Fz0 = FNOMIN·LFZO (N).
     pub fz0: f64,
@@ -188,6 +218,29 @@ impl Extension {
             };
             e.lmuv = Some((p.lmuv, v0));
         }
+        let dmu = number(t, SPEED_SECTION, SPEED_KEYS[0])?;
+        let vc = number(t, SPEED_SECTION, SPEED_KEYS[1])?;
+        let mu0 = number(t, SPEED_SECTION, SPEED_KEYS[2])?.unwrap_or(0.0);
+        if !(mu0 > -1.0) {
+            return Err(bad("MU0", "[SPEED_FRICTION] MU0 must be above -1 (the friction level 1 + MU0 must stay positive)"));
+        }
+        if let Some(d) = dmu.filter(|d| *d != 0.0) {
+            if d >= 1.0 {
+                return Err(bad(
+                    "DMU",
+                    "[SPEED_FRICTION] DMU must be below 1 (the friction left at high sliding speed, 1 - DMU, must stay positive)",
+                ));
+            }
+            match vc {
+                Some(v) if v > 0.0 => e.speed = Some((d, v, mu0)),
+                _ => {
+                    return Err(bad(
+                        "VC",
+                        "[SPEED_FRICTION] needs VC > 0 (m/s, the sliding speed of half the friction change)",
+                    ))
+                }
+            }
+        }
         let mut th = [f64::NAN; 6];
         let mut any = false;
         for (v, k) in th.iter_mut().zip(THERMAL_KEYS) {
@@ -213,7 +266,7 @@ impl Extension {
             e.thermal = Some(m);
         }
         Ok(
-            if e.load.is_some() || e.lmuv.is_some() || e.thermal.is_some() {
+            if e.load.is_some() || e.lmuv.is_some() || e.speed.is_some() || e.thermal.is_some() {
                 Some(e)
             } else {
                 None
@@ -232,6 +285,12 @@ impl Extension {
         }
         if let Some((lmuv, _)) = self.lmuv {
             t.p.lmuv = lmuv;
+        }
+        if let Some((d, v, m)) = self.speed {
+            let s = t.extra_section(SPEED_SECTION);
+            for (k, x) in SPEED_KEYS.iter().zip([d, v, m]) {
+                s.set(k, x);
+            }
         }
         if let Some(m) = self.thermal {
             let s = t.extra_section(THERMAL_SECTION);
@@ -252,9 +311,14 @@ impl Extension {
             s *= 1.0 + m1 * dfz + m2 * dfz * dfz;
             c *= 1.0 + k1 * dfz;
         }
-        if let Some((lmuv, v0)) = self.lmuv {
+        if self.lmuv.is_some() || self.speed.is_some() {
             let vs = kin.vx_abs * (kin.kappa * kin.kappa + kin.tan_alpha * kin.tan_alpha).sqrt();
-            s /= 1.0 + lmuv * vs / v0;
+            if let Some((lmuv, v0)) = self.lmuv {
+                s /= 1.0 + lmuv * vs / v0;
+            }
+            if let Some((dmu, vc, mu0)) = self.speed {
+                s *= (1.0 + mu0) * speed_friction(dmu, vc, vs);
+            }
         }
         if let Some(m) = self.thermal {
             s *= m.friction(st.x[SLOT_TEMP]);
@@ -329,5 +393,64 @@ mod tests {
         let bad = with("[TYREKIT]\nTRANSIENT = 'fast'\n");
         let e = file_transient(&bad).unwrap_err().to_string();
         assert!(e.contains("TRANSIENT") && e.contains("relaxation"), "{e}");
+    }
+
+    /// The general sliding-speed law against two other formulations of
+    /// the same physics: the LMUV law 1/(1 + LMUV·Vs/V0) is the member
+    /// DMU = 1, VC = V0/LMUV (identical to rounding), and an exponential
+    /// Stribeck-type fall 1 − a·(1 − e^(−Vs/v)) is matched, after a fit of
+    /// (DMU, VC) by grid search over 0–10 m/s, to within 10 % of its own
+    /// fall a (the two shapes differ in how they level off; 10 % of the
+    /// fall is below what a tyre test separates). The file keys read back,
+    /// and DMU ≥ 1 or a missing VC is refused naming the key.
+    #[test]
+    fn speed_friction_law_covers_other_formulations() {
+        let (lmuv, v0) = (0.8, 16.7);
+        for vs in [0.0, 0.3, 1.0, 3.0, 10.0] {
+            let a = 1.0 / (1.0 + lmuv * vs / v0);
+            let b = speed_friction(1.0, v0 / lmuv, vs);
+            assert!((a - b).abs() < 1e-12, "vs {vs}: {a} vs {b}");
+        }
+        let (fall, v) = (0.1, 1.5);
+        let exp = |vs: f64| 1.0 - fall * (1.0 - (-vs / v).exp());
+        let grid: Vec<f64> = (0..=100).map(|i| 0.1 * i as f64).collect();
+        let mut best = (f64::INFINITY, 0.0, 0.0);
+        for i in 1..=60 {
+            let dmu = 0.005 * i as f64;
+            for j in 1..=60 {
+                let vc = 0.1 * j as f64;
+                let e = grid
+                    .iter()
+                    .map(|&x| (speed_friction(dmu, vc, x) - exp(x)).abs())
+                    .fold(0.0, f64::max);
+                if e < best.0 {
+                    best = (e, dmu, vc);
+                }
+            }
+        }
+        assert!(
+            best.0 < 0.1 * fall,
+            "largest misfit {:.4} of a fall {fall}",
+            best.0
+        );
+        // Monotone in the sliding speed for a fall and for a rise.
+        for d in [0.3, -0.2] {
+            let s: Vec<f64> = grid.iter().map(|&x| speed_friction(d, 1.0, x)).collect();
+            assert!(s.windows(2).all(|w| (w[1] - w[0]) * d <= 0.0));
+        }
+        let t = with("[SPEED_FRICTION]\nDMU = 0.12\nVC = 1.5\nMU0 = 0.03\n");
+        let e = Extension::from_params(&t).unwrap().unwrap();
+        assert_eq!(e.speed, Some((0.12, 1.5, 0.03)));
+        let mut w = with("");
+        e.write_to(&mut w);
+        let back = TyreParams::from_tir_str(&w.to_tir_string(), "w.tir").unwrap();
+        assert_eq!(
+            Extension::from_params(&back).unwrap().unwrap().speed,
+            Some((0.12, 1.5, 0.03))
+        );
+        let bad = Extension::from_params(&with("[SPEED_FRICTION]\nDMU = 1.2\nVC = 1\n"));
+        assert!(bad.unwrap_err().to_string().contains("DMU"));
+        let bad = Extension::from_params(&with("[SPEED_FRICTION]\nDMU = 0.1\n"));
+        assert!(bad.unwrap_err().to_string().contains("VC"));
     }
 }

@@ -238,6 +238,7 @@ pub fn fit_mf(
     }
     widen_ranges(&mut tyre, recs)?;
     let geometry = if opts.geometry {
+        let _t = super::timing::span(|| "geometry".into());
         Some(super::geometry::fit_geometry(&mut tyre, recs)?)
     } else {
         None
@@ -265,6 +266,7 @@ pub fn fit_mf(
         if !opts.only.contains(&kind) {
             continue;
         }
+        let _t = super::timing::span(|| format!("stage {}", kind.name()));
         let (seg, all_channels) = kind.segments_and_channels();
         let recorded = |c: &Channel| recs.iter().any(|r| r.has(c.name()));
         let channels: &[Channel] = &all_channels
@@ -340,6 +342,7 @@ pub fn fit_mf(
         skipped.extend(skip);
     }
     // Quality: every fitted channel over its segments, fitted and held out.
+    let _t = super::timing::span(|| "metrics".into());
     let model = Model::new(tyre.p.clone(), form);
     for (c, seg) in &fitted_channels {
         if fitted_channels

@@ -76,7 +76,7 @@ impl Default for MfFitOptions {
 /// than 1e-9 of the cost ends the polish. Measured on the dev set (r05,
 /// combined stage, 167 232 residuals): the last 12 of 30 full-data
 /// iterations at the library default 1e-12 lowered the cost by 1.2e-8 of
-/// it (the fitted figures agree to 7 digits) and took 40 % of the stage's
+/// it (the fitted and held-out figures agree to 6 significant digits) and took 40 % of the stage's
 /// time; SciPy's `least_squares` stops at ftol = 1e-8.
 pub const STAGED_FTOL: f64 = 1e-9;
 

@@ -21,7 +21,10 @@ pub fn eval<T: Real>(model: &Model<T>, c: &Conditions, channel: Channel) -> T {
         Channel::Fy => model.fy_only(c),
         Channel::Mx => model.mx_only(c),
         Channel::My => model.my_only(c),
-        Channel::Mz => model.solve(c).mz,
+        // Mz needs the combined Fx, Fy and the trail: the full solution,
+        // without the rolling resistance moment it does not use
+        // (`solve_parts`: every other field the same bits as `solve`).
+        Channel::Mz => model.solve_parts(c, 1.0, false).mz,
         // Fz is the model's input, not a predicted channel (as `Channel::of`).
         Channel::Fz => T::from(f64::NAN),
     }

@@ -322,6 +322,7 @@ pub fn fit_stage_from(
     extra_starts: &[Vec<f64>],
 ) -> crate::Result<FitOutcome> {
     let m = data.conds.len();
+    let t_build = super::timing::span(|| format!("  {name}: build ({m} samples)"));
     let coarse =
         (opts.coarse_first && m > 2 * COARSE_SAMPLES).then(|| data.every(m / COARSE_SAMPLES));
     let weights: Vec<f64> = data
@@ -401,8 +402,11 @@ pub fn fit_stage_from(
         (None, Some(p)) => Some(p),
         (None, None) => None,
     };
+    drop(t_build);
     let mut start = None;
     if !extra_starts.is_empty() {
+        let _t =
+            super::timing::span(|| format!("  {name}: best_start ({})", extra_starts.len() + 1));
         start = Some(best_start(
             problem,
             coarse_problem,

@@ -50,6 +50,7 @@ pub mod pso;
 pub mod recording;
 pub mod report;
 pub mod solve;
+pub mod timing;
 pub mod transient;
 pub mod validity;
 

@@ -204,6 +204,7 @@ pub fn fit_global(
     let mut starts: Vec<Vec<f64>> = Vec::new();
     let mut swarm_cost = None;
     if let Some(po) = &opts.pso {
+        let _t = super::timing::span(|| format!("    {stage}: swarm"));
         let cols: Vec<usize> = (0..n_all).filter(|&i| free_in[i]).collect();
         if !cols.is_empty() {
             let lo: Vec<f64> = cols.iter().map(|&c| params[c].lower).collect();
@@ -273,6 +274,12 @@ pub fn fit_global(
             loose.lm.xtol = loose.lm.xtol.max(1e-6);
             loose.lm.gtol = loose.lm.gtol.max(1e-6);
             let mut cws = Workspace::new(swarm_problem.n_residuals(), 0);
+            let _t = super::timing::span(|| {
+                format!(
+                    "    {stage}: coarse polish ({})",
+                    swarm_problem.n_residuals()
+                )
+            });
             // A failing coarse polish leaves the candidate as it was.
             if let Ok(c) = polish(
                 swarm_problem,
@@ -289,6 +296,8 @@ pub fn fit_global(
                 polish_opts = Some(&near);
             }
         }
+        let _t =
+            super::timing::span(|| format!("    {stage}: full polish ({})", problem.n_residuals()));
         let p = match polish(
             problem,
             cand,
@@ -327,6 +336,7 @@ pub fn fit_global(
     let cols0: Vec<usize> = (0..n_all).filter(|&i| free_in[i]).collect();
 
     // 5. Standard errors over the identified free set.
+    let _t = super::timing::span(|| format!("    {stage}: standard errors"));
     let mut stderr = vec![None; n_all];
     let mut correlated = Vec::new();
     let n_free = (0..n_all).filter(|&i| free[i]).count();
@@ -509,6 +519,18 @@ fn polish(
             Some(&mut cb),
         )?;
         theta = res.theta;
+        if super::timing::enabled() {
+            eprintln!(
+                "timing:       {stage}: LM round {round} on {} rows: cost {:.6e} -> {:.6e}, {} linearisations, {} trial evaluations, {:?}{}",
+                problem.n_residuals(),
+                res.initial_cost,
+                res.cost,
+                res.iterations,
+                res.residual_evals,
+                res.termination,
+                if loose { " (loose)" } else { "" }
+            );
+        }
         iterations += res.iterations;
         termination = res.termination;
         cost = res.cost;

@@ -176,7 +176,7 @@ fn print_table(v: &[Outcome]) {
 const MEDIAN_MAX: [(&str, f64); 2] = [("pure", 1.10), ("all", 2.30)];
 
 #[test]
-#[ignore = "regressed: the last complete run (validity rows, use mode 111, Mz in the combined stage) measured pure median 1.16 > 1.10; the committed code (multi-start, combined stage over pure rows too) was spot-checked on r04/r07 only"]
+#[ignore = "regressed: the complete run of 2026-11-25 (before the combined-stage gate) measured pure median 1.21 > 1.10, all rows 1.73; the gate and the data-driven starts were measured on r04/r07 only"]
 fn devset_fit_does_not_get_worse() {
     let Some(v) = outcomes() else { return };
     for (g, max) in MEDIAN_MAX {

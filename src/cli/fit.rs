@@ -183,6 +183,9 @@ pub fn run(args: Args) -> Result<()> {
     for s in &res.skipped {
         eprintln!("tyrekit fit: stage skipped: {s}");
     }
+    for d in &res.decisions {
+        eprintln!("tyrekit fit: {d}");
+    }
     if res.report.stages.is_empty() && res.report.relaxation.is_empty() {
         return Err(Error::Input(format!(
             "fit: no stage had usable data ({}); nothing written to {}",

@@ -21,6 +21,8 @@ use crate::mf::{form_of, Model};
 use crate::tir::TyreParams;
 use std::ops::Range;
 
+mod gate;
+
 /// Settings of [`fit_mf`].
 #[derive(Clone, Debug)]
 pub struct MfFitOptions {
@@ -89,6 +91,9 @@ pub struct MfFit {
     pub report: FitReport,
     /// Stages skipped and why.
     pub skipped: Vec<String>,
+    /// Which candidate of a gated stage was kept and the figures that decided
+    /// it ([`gate`]).
+    pub decisions: Vec<String>,
     /// Per recording: the (train, held-out) sample ranges.
     pub splits: Vec<TrainTest>,
     /// The geometry fit, when [`MfFitOptions::geometry`] asked for it.
@@ -236,6 +241,99 @@ fn segment_ranges(
     out
 }
 
+/// What every stage of one [`fit_mf`] call shares.
+pub(crate) struct StageCtx<'a> {
+    pub recs: &'a [Recording],
+    /// Per recording: the fitted sample ranges.
+    pub train: &'a [Vec<Range<usize>>],
+    pub grid: &'a Grid,
+    pub opts: &'a MfFitOptions,
+    pub form: crate::mf::Form,
+}
+
+/// A stage's outcome: skipped (why), or fitted with the channels it fitted.
+pub(crate) enum StageRun {
+    Skipped(String),
+    Done(super::solve::FitOutcome, Vec<Channel>),
+}
+
+/// Run stage `kind` from the values of `tyre` on the fitted rows: its
+/// channels where recorded, its samples (the combined stage: the combined
+/// rows and the pure ones, see below), its parameter table. `multi_start`:
+/// converge from the current values, the neutral start and the data-driven
+/// one ([`super::initial`]) and polish the best; otherwise polish from the
+/// current values only (a re-fit after a later stage).
+pub(crate) fn run_stage(
+    ctx: &StageCtx,
+    kind: StageKind,
+    tyre: &TyreParams,
+    multi_start: bool,
+    progress: Option<&mut ProgressFn>,
+) -> crate::Result<StageRun> {
+    let (recs, opts) = (ctx.recs, ctx.opts);
+    let (seg, all_channels) = kind.segments_and_channels();
+    let recorded = |c: &Channel| recs.iter().any(|r| r.has(c.name()));
+    let channels: Vec<Channel> = all_channels
+        .iter()
+        .copied()
+        .filter(|c| recorded(c) || !kind.optional(*c))
+        .collect();
+    if !channels.iter().all(recorded) {
+        return Ok(StageRun::Skipped(format!(
+            "{}: the data have no {:?} channel",
+            kind.name(),
+            channels
+        )));
+    }
+    let mut data = gather(&tyre.p, recs, Some(ctx.train), seg, &channels);
+    data.grid = Some(ctx.grid.clone());
+    if data.conds.len() < opts.min_samples {
+        return Ok(StageRun::Skipped(format!(
+            "{}: {} samples in {} segments (need {})",
+            kind.name(),
+            data.conds.len(),
+            seg.label(),
+            opts.min_samples
+        )));
+    }
+    if kind == StageKind::Combined {
+        // The combined weights act on the pure rows too (κ and α are
+        // never exactly 0 there: Gyκ, SVyκ, Gxα and Mz's s·Fx apply), so
+        // the stage fits them with the combined rows: fitted on the
+        // combined runs alone they were free to spoil the pure ones
+        // (dev set: pure Fy 1.01 → 2.03 × baseline on r04).
+        for pure in [SegmentKind::PureLateral, SegmentKind::PureLongitudinal] {
+            data.append(gather(&tyre.p, recs, Some(ctx.train), pure, &channels));
+        }
+    }
+    let params = stage_params(
+        kind,
+        &tyre.p,
+        data.gamma_spread < CAMBER_SPREAD,
+        data.p_spread < PRESSURE_SPREAD,
+    );
+    let mut extra = Vec::new();
+    if multi_start && !matches!(kind, StageKind::Mx | StageKind::My) {
+        extra.push(neutral_start(kind, &params));
+        if let Some(s) = super::initial::estimate(kind, &tyre.p, &data, &params) {
+            extra.push(s);
+        }
+    }
+    let out = fit_stage_from(
+        ctx.form,
+        &tyre.p,
+        &params,
+        &data,
+        &channels,
+        opts.threads,
+        &opts.fit,
+        kind.name(),
+        progress,
+        &extra,
+    )?;
+    Ok(StageRun::Done(out, channels))
+}
+
 /// Fit the Magic Formula to `recs` from `start` (whose version decides the
 /// equation set). See the module doc.
 pub fn fit_mf(
@@ -274,77 +372,65 @@ pub fn fit_mf(
         ..Default::default()
     };
     let mut skipped = Vec::new();
+    let mut decisions = Vec::new();
     let mut fitted_channels: Vec<(Channel, crate::data::SegmentKind)> = Vec::new();
+    let mut ran: Vec<StageKind> = Vec::new();
+    let ctx = StageCtx {
+        recs,
+        train: &train,
+        grid: &grid,
+        opts,
+        form,
+    };
+    // The rows a stage's acceptance is judged on: the held-out rows where
+    // `--holdout` keeps some, else the fitted ones (issue #14 item 3: pick
+    // by held-out error, not by in-sample cost).
+    let test: Vec<Vec<Range<usize>>> = splits.iter().map(|s| s.1.clone()).collect();
+    let judge_rows = if test.iter().any(|t| !t.is_empty()) {
+        &test
+    } else {
+        &train
+    };
     for kind in StageKind::ALL {
         if !opts.only.contains(&kind) {
             continue;
         }
         let _t = super::timing::span(|| format!("stage {}", kind.name()));
-        let (seg, all_channels) = kind.segments_and_channels();
-        let recorded = |c: &Channel| recs.iter().any(|r| r.has(c.name()));
-        let channels: &[Channel] = &all_channels
-            .iter()
-            .copied()
-            .filter(|c| recorded(c) || !kind.optional(*c))
-            .collect::<Vec<_>>();
-        if !channels.iter().all(recorded) {
-            skipped.push(format!(
-                "{}: the data have no {:?} channel",
-                kind.name(),
-                channels
-            ));
-            continue;
-        }
-        let mut data = gather(&tyre.p, recs, Some(&train), seg, channels);
-        data.grid = Some(grid.clone());
-        if data.conds.len() < opts.min_samples {
-            skipped.push(format!(
-                "{}: {} samples in {} segments (need {})",
-                kind.name(),
-                data.conds.len(),
-                seg.label(),
-                opts.min_samples
-            ));
-            continue;
-        }
-        if kind == StageKind::Combined {
-            // The combined weights act on the pure rows too (κ and α are
-            // never exactly 0 there: Gyκ, SVyκ, Gxα and Mz's s·Fx apply), so
-            // the stage fits them with the combined rows: fitted on the
-            // combined runs alone they were free to spoil the pure ones
-            // (dev set: pure Fy 1.01 → 2.03 × baseline on r04).
-            for pure in [SegmentKind::PureLateral, SegmentKind::PureLongitudinal] {
-                data.append(gather(&tyre.p, recs, Some(&train), pure, channels));
+        let before = tyre.clone();
+        let (out, channels) = match run_stage(&ctx, kind, &tyre, true, progress.as_deref_mut())? {
+            StageRun::Skipped(why) => {
+                skipped.push(why);
+                continue;
             }
-        }
-        let params = stage_params(
-            kind,
-            &tyre.p,
-            data.gamma_spread < CAMBER_SPREAD,
-            data.p_spread < PRESSURE_SPREAD,
-        );
-        let extra = if matches!(kind, StageKind::Mx | StageKind::My) {
-            Vec::new()
-        } else {
-            vec![neutral_start(kind, &params)]
+            StageRun::Done(out, channels) => (out, channels),
         };
-        let out = fit_stage_from(
-            form,
-            &tyre.p,
-            &params,
-            &data,
-            channels,
-            opts.threads,
-            &opts.fit,
-            kind.name(),
-            progress.as_deref_mut(),
-            &extra,
-        )?;
         for p in &out.params {
             tyre.set(&p.name, p.value)?;
         }
-        report.stages.push(out);
-        for &c in channels {
+        let mut outs = vec![out];
+        if kind == StageKind::Combined {
+            let pure: Vec<StageKind> = ran
+                .iter()
+                .copied()
+                .filter(|k| matches!(k, StageKind::PureFx | StageKind::PureFy | StageKind::Mz))
+                .collect();
+            let (t, o, note) = gate::accept_combined(
+                &ctx,
+                &before,
+                tyre,
+                &pure,
+                &channels,
+                judge_rows,
+                progress.as_deref_mut(),
+            )?;
+            tyre = t;
+            outs.extend(o);
+            decisions.push(note);
+        }
+        report.stages.extend(outs);
+        ran.push(kind);
+        let (seg, _) = kind.segments_and_channels();
+        for &c in &channels {
             fitted_channels.push((c, seg));
         }
     }
@@ -390,6 +476,7 @@ pub fn fit_mf(
         tyre,
         report,
         skipped,
+        decisions,
         splits,
         geometry,
     })

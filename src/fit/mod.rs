@@ -40,6 +40,7 @@ pub mod geometry;
 pub mod grad_pure;
 pub mod holdout;
 pub mod identify;
+pub(crate) mod initial;
 pub mod lm;
 pub mod loss;
 pub mod metrics;

@@ -1,0 +1,237 @@
+//! gate — a later stage must not spoil what an earlier one fitted
+//! (issue #14 item 3): the combined-slip stage's result is compared, on the
+//! judged rows (held out where `--holdout` keeps some), with the tyre before
+//! it and with the result after the pure stages were re-polished under the
+//! new combined weights; the candidate kept is the best one that does not
+//! raise any pure-slip channel's error (else the best-scoring of all,
+//! the tyre before included).
+//!
+//! Must never: pick by the fitted rows' cost when held-out rows exist, keep
+//! a candidate that raises a pure-slip channel's judged error beyond
+//! [`TOL`] while a candidate that does not exists, or print.
+
+use super::{run_stage, StageCtx, StageRun};
+use crate::data::SegmentKind;
+use crate::fit::mf_stages::{conditions_of, Channel, StageKind};
+use crate::fit::solve::{FitOutcome, ProgressFn};
+use crate::mf::Model;
+use crate::tir::TyreParams;
+use std::ops::Range;
+
+/// Relative rise of a pure channel's judged mean-square error still taken
+/// as "not raised": 2 % in mean square is 1 % in NRMSE, a tenth of the
+/// margin of issue #14's 1.15× goal, below which a decision between
+/// candidates is not worth a worse all-row fit.
+pub const TOL: f64 = 0.02;
+
+/// The segments a channel's pure-slip error is judged on.
+fn pure_kind(c: Channel) -> SegmentKind {
+    if c == Channel::Fx {
+        SegmentKind::PureLongitudinal
+    } else {
+        SegmentKind::PureLateral
+    }
+}
+
+/// Per channel: (Σ residual², Σ measured²) over `kind` rows of `rows`.
+fn errors(
+    ctx: &StageCtx,
+    tyre: &TyreParams,
+    rows: &[Vec<Range<usize>>],
+    kind: SegmentKind,
+    channels: &[Channel],
+) -> Vec<(f64, f64)> {
+    let model = Model::new(tyre.p.clone(), ctx.form);
+    let mut acc = vec![(0.0, 0.0); channels.len()];
+    for (r, rec) in ctx.recs.iter().enumerate() {
+        for seg in rec.segments.iter().filter(|s| s.kind == kind) {
+            for rg in &rows[r] {
+                let (a, b) = (
+                    seg.start.max(rg.start),
+                    seg.end.min(rg.end).min(rec.samples.len()),
+                );
+                for s in rec.samples.get(a..b).unwrap_or(&[]) {
+                    let usable = s.fz > 0.0
+                        && [s.fz, s.vx, s.kappa, s.alpha, s.gamma]
+                            .iter()
+                            .all(|v| v.is_finite());
+                    if !usable {
+                        continue;
+                    }
+                    let sol = model.solve(&conditions_of(&tyre.p, s));
+                    for (k, c) in channels.iter().enumerate() {
+                        let y = c.measured(s);
+                        let e = c.of(&sol) - y;
+                        if e.is_finite() {
+                            acc[k].0 += e * e;
+                            acc[k].1 += y * y;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    acc
+}
+
+/// Judged figures of one candidate.
+struct Judged {
+    /// Per channel: mean-square error on its pure rows.
+    pure: Vec<f64>,
+    /// Σ over channels of Σe²/Σy² on pure and combined rows together: the
+    /// combined stage's own objective on the judged rows.
+    score: f64,
+}
+
+fn judge(
+    ctx: &StageCtx,
+    tyre: &TyreParams,
+    rows: &[Vec<Range<usize>>],
+    channels: &[Channel],
+) -> Judged {
+    let comb = errors(ctx, tyre, rows, SegmentKind::Combined, channels);
+    let mut pure = Vec::new();
+    let mut score = 0.0;
+    for (k, &c) in channels.iter().enumerate() {
+        let p = errors(ctx, tyre, rows, pure_kind(c), &[c])[0];
+        pure.push(p.0);
+        let den = p.1 + comb[k].1;
+        if den > 0.0 {
+            score += (p.0 + comb[k].0) / den;
+        }
+    }
+    Judged { pure, score }
+}
+
+/// The rule: among the candidates that raise no pure channel's judged
+/// error beyond [`TOL`], the least score; when every candidate raises one,
+/// the least score among them and the tyre before (`j0`) — the move is then
+/// kept only where the held-out error over the stage's rows proves it
+/// better. `None`: keep the tyre before.
+fn choose(j0: &Judged, cands: &[&Judged]) -> Option<usize> {
+    let ok = |j: &Judged| {
+        j.pure
+            .iter()
+            .zip(&j0.pure)
+            .all(|(a, b)| *a <= b * (1.0 + TOL) || *b == 0.0)
+    };
+    let least = |f: &dyn Fn(&Judged) -> bool| {
+        cands
+            .iter()
+            .enumerate()
+            .filter(|(_, j)| f(j))
+            .min_by(|a, b| a.1.score.total_cmp(&b.1.score))
+            .map(|(i, j)| (i, j.score))
+    };
+    match least(&ok) {
+        Some((i, _)) => Some(i),
+        None => least(&|_| true)
+            .filter(|(_, s)| *s < j0.score)
+            .map(|(i, _)| i),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn j(pure: &[f64], score: f64) -> Judged {
+        Judged {
+            pure: pure.to_vec(),
+            score,
+        }
+    }
+
+    /// r04/r07 of the dev set gave these shapes: the stage alone raises
+    /// pure Mz (×2.2, ×3.1 in mean square) at a better score; the re-polish
+    /// keeps the pure rows. The rule must take the re-polish, not the
+    /// lowest score; and when both raise a pure channel, the lowest score
+    /// only if it beats the tyre before.
+    #[test]
+    fn a_stage_may_not_spoil_the_pure_rows() {
+        let before = j(&[1.0, 1.0, 1.0], 0.37);
+        let stage = j(&[0.98, 1.06, 2.16], 0.030);
+        let polished = j(&[1.0, 0.99, 0.91], 0.036);
+        assert_eq!(choose(&before, &[&stage, &polished]), Some(1));
+        // Both raise Fy: the better score wins if it beats the tyre before…
+        let polished = j(&[1.0, 1.09, 0.94], 0.0081);
+        let before = j(&[1.0, 1.0, 1.0], 0.0084);
+        let stage = j(&[1.0, 1.15, 3.05], 0.0216);
+        assert_eq!(choose(&before, &[&stage, &polished]), Some(1));
+        // …and the tyre before is kept when it scores best.
+        let before = j(&[1.0, 1.0, 1.0], 0.0080);
+        assert_eq!(choose(&before, &[&stage, &polished]), None);
+        // A rise within TOL is not a rise.
+        let before = j(&[1.0], 1.0);
+        assert_eq!(choose(&before, &[&j(&[1.0 + 0.5 * TOL], 0.5)]), Some(0));
+    }
+}
+
+/// Decide the combined stage: candidates `after` (the stage's result) and
+/// `after` with the `pure` stages re-polished from its values; `before` the
+/// tyre the stage started from. Returns the kept tyre, the outcomes of the
+/// re-polish when it is kept, and a line saying what was kept and why.
+pub(crate) fn accept_combined(
+    ctx: &StageCtx,
+    before: &TyreParams,
+    after: TyreParams,
+    pure: &[StageKind],
+    channels: &[Channel],
+    rows: &[Vec<Range<usize>>],
+    mut progress: Option<&mut ProgressFn>,
+) -> crate::Result<(TyreParams, Vec<FitOutcome>, String)> {
+    let mut polished = after.clone();
+    let mut outs = Vec::new();
+    for &k in pure {
+        if let StageRun::Done(o, _) = run_stage(ctx, k, &polished, false, progress.as_deref_mut())?
+        {
+            for p in &o.params {
+                polished.set(&p.name, p.value)?;
+            }
+            outs.push(o);
+        }
+    }
+    let j0 = judge(ctx, before, rows, channels);
+    let cands = [
+        ("combined", judge(ctx, &after, rows, channels)),
+        (
+            "combined + pure re-polish",
+            judge(ctx, &polished, rows, channels),
+        ),
+    ];
+    let pick = choose(&j0, &cands.iter().map(|c| &c.1).collect::<Vec<_>>());
+    let figures = |j: &Judged| {
+        let v: Vec<String> = channels
+            .iter()
+            .zip(&j.pure)
+            .zip(&j0.pure)
+            .map(|((c, a), b)| format!("{} {:.3}", c.name(), if *b > 0.0 { a / b } else { 1.0 }))
+            .collect();
+        format!("pure MSE/before [{}], score {:.4}", v.join(", "), j.score)
+    };
+    let detail: Vec<String> = cands
+        .iter()
+        .map(|(n, j)| format!("{n}: {}", figures(j)))
+        .collect();
+    let note = |kept: &str| {
+        format!(
+            "combined stage: kept {kept} (judged on {} rows; before: score {:.4}; {})",
+            if std::ptr::eq(rows, ctx.train) {
+                "fitted"
+            } else {
+                "held-out"
+            },
+            j0.score,
+            detail.join("; ")
+        )
+    };
+    Ok(match pick {
+        Some(0) => (after, Vec::new(), note(cands[0].0)),
+        Some(_) => (polished, outs, note(cands[1].0)),
+        None => (
+            before.clone(),
+            Vec::new(),
+            note("the tyre before it (its judged score is the least)"),
+        ),
+    })
+}

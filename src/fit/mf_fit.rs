@@ -263,6 +263,32 @@ pub(crate) enum StageRun {
 /// converge from the current values, the neutral start and the data-driven
 /// one ([`super::initial`]) and polish the best; otherwise polish from the
 /// current values only (a re-fit after a later stage).
+/// Combined-slip coefficients that shape the weights' dependence on the
+/// slip angle (Pacejka, *Tyre and Vehicle Dynamics*, eqs. 4.E54–4.E57 for
+/// Gxα: Cxα, Exα; 4.E62–4.E67 for Gyκ and SVyκ: the α terms of Byκ and
+/// DVyκ). Drive/brake runs at one non-zero slip angle fix each weight at that
+/// angle only — the shape is then a free extrapolation (collinear with RBX1,
+/// RBY1, RVY1, and driven to its bounds by noise) — so these are held at
+/// their start values unless the combined runs cover two slip angles or more.
+const SLIP_ANGLE_SHAPE: [&str; 6] = ["rcx1", "rex1", "rex2", "rby2", "rby3", "rvy4"];
+
+/// Number of distinct non-zero |α| levels of the drive/brake samples
+/// (|κ| > 0.01) in `conds`: |α| in 0.5° bins, a bin counted when it holds
+/// ≥ 5 % of those samples (a test plan's slip-angle steps are ≥ 1°; the
+/// transitions between blocks fall below 5 %).
+fn slip_angle_levels(conds: &[crate::mf::Conditions]) -> usize {
+    let step = 0.5f64.to_radians();
+    let mut bins = std::collections::BTreeMap::<i64, usize>::new();
+    let mut n = 0usize;
+    for c in conds.iter().filter(|c| c.kappa.abs() > 0.01) {
+        n += 1;
+        *bins
+            .entry((c.alpha.abs() / step).round() as i64)
+            .or_default() += 1;
+    }
+    bins.iter().filter(|(&b, &k)| b != 0 && k * 20 >= n).count()
+}
+
 pub(crate) fn run_stage(
     ctx: &StageCtx,
     kind: StageKind,
@@ -296,6 +322,9 @@ pub(crate) fn run_stage(
             opts.min_samples
         )));
     }
+    // Slip-angle levels of the combined runs, counted before the pure rows
+    // join them (see `SLIP_ANGLE_SHAPE`).
+    let combined_alpha_levels = slip_angle_levels(&data.conds);
     if kind == StageKind::Combined {
         // The combined weights act on the pure rows too (κ and α are
         // never exactly 0 there: Gyκ, SVyκ, Gxα and Mz's s·Fx apply), so
@@ -306,12 +335,19 @@ pub(crate) fn run_stage(
             data.append(gather(&tyre.p, recs, Some(ctx.train), pure, &channels));
         }
     }
-    let params = stage_params(
+    let mut params = stage_params(
         kind,
         &tyre.p,
         data.gamma_spread < CAMBER_SPREAD,
         data.p_spread < PRESSURE_SPREAD,
     );
+    if kind == StageKind::Combined && combined_alpha_levels < 2 {
+        for p in params.iter_mut() {
+            if SLIP_ANGLE_SHAPE.contains(&p.name.to_ascii_lowercase().as_str()) {
+                *p = p.clone().fixed();
+            }
+        }
+    }
     let mut extra = Vec::new();
     if multi_start && !matches!(kind, StageKind::Mx | StageKind::My) {
         extra.push(neutral_start(kind, &params));
@@ -487,4 +523,45 @@ pub fn overall_sigma(m: &[ChannelMetric], channel: &str) -> Option<f64> {
     m.iter()
         .find(|x| x.channel == channel && x.condition.is_none())
         .map(|x| x.sigma)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::slip_angle_levels;
+    use crate::mf::Conditions;
+
+    fn runs(levels_deg: &[f64]) -> Vec<Conditions> {
+        let mut v = Vec::new();
+        for &a in levels_deg {
+            for i in 0..200 {
+                v.push(Conditions {
+                    alpha: a.to_radians(),
+                    kappa: -0.2 + 0.4 * i as f64 / 199.0,
+                    ..Default::default()
+                });
+            }
+        }
+        v
+    }
+
+    #[test]
+    fn slip_angle_levels_count_the_drive_brake_blocks() {
+        // A test plan at SA 0 and −3°: one non-zero level; the shape of
+        // the weights in α is then not determined.
+        assert_eq!(slip_angle_levels(&runs(&[0.0, -3.0])), 1);
+        // SA 0, −3, −6: two; ±3 counts once (|α| — the weights' shape
+        // terms are even in α without a shift).
+        assert_eq!(slip_angle_levels(&runs(&[0.0, -3.0, -6.0])), 2);
+        assert_eq!(slip_angle_levels(&runs(&[3.0, -3.0])), 1);
+        // A few samples of a transition between blocks do not count.
+        let mut c = runs(&[0.0, -3.0]);
+        c.extend(runs(&[-6.0]).into_iter().take(5));
+        assert_eq!(slip_angle_levels(&c), 1);
+        // Free-rolling samples (|κ| ≤ 0.01) are not drive/brake runs.
+        let free: Vec<Conditions> = runs(&[-6.0, -9.0])
+            .into_iter()
+            .map(|c| Conditions { kappa: 0.0, ..c })
+            .collect();
+        assert_eq!(slip_angle_levels(&free), 0);
+    }
 }

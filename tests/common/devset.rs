@@ -292,7 +292,10 @@ pub fn run_all<T: Send>(
     if let Ok(only) = std::env::var("TYREKIT_DEVSET_ONLY") {
         let keep: Vec<&str> = only.split(',').map(str::trim).collect();
         answers.retain(|a| keep.contains(&a.name.as_str()));
-        eprintln!("NOTE {test}: partial run over {:?} (TYREKIT_DEVSET_ONLY)", keep);
+        eprintln!(
+            "NOTE {test}: partial run over {:?} (TYREKIT_DEVSET_ONLY)",
+            keep
+        );
     }
     let work = Path::new(env!("CARGO_TARGET_TMPDIR")).join(test);
     std::fs::create_dir_all(&work).expect("work dir");

@@ -3,6 +3,7 @@
 //! One file per area; `tyrekit bench [AREA…]` runs them.
 //! Must never: be used as a pass/fail test (timings are reported, not asserted).
 
+pub mod brush;
 pub mod data;
 pub mod diagnose;
 pub mod fit;
@@ -27,6 +28,7 @@ pub const SECTIONS: &[Section] = &[
     ("mf", mf::run),
     ("fmu", fmu::run),
     ("transient", transient::run),
+    ("brush", brush::run),
     ("fit", fit::run),
     ("diagnose", diagnose::run),
     ("data", data::run),

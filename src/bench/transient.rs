@@ -36,7 +36,7 @@ fn input(i: usize, v0: f64, re: f64) -> WheelInput {
 
 /// ns per call of `f` over `n` calls: the best 1000-call chunk (the machine is
 /// shared, so the minimum is the figure least disturbed by other work).
-fn time_ns(n: usize, reps: usize, mut f: impl FnMut(usize)) -> f64 {
+pub(crate) fn time_ns(n: usize, reps: usize, mut f: impl FnMut(usize)) -> f64 {
     const CHUNK: usize = 1000;
     let mut best = f64::INFINITY;
     for _ in 0..reps {

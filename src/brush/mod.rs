@@ -24,7 +24,8 @@
 //! Magic Formula ([`params`]). Selectable as the force model of the
 //! transient models (`TransientOptions::brush`), in `eval`/`replay`
 //! (`--force-model brush`), the FMU (`force_model = brush`), fitted by
-//! `fit --model brush` (`crate::fit::brush`); the paper's study is still to do.
+//! `fit --model brush` (`crate::fit::brush`); the paper's study of tread
+//! stiffness in `study.rs` ([`sensitivity`], `tyrekit brush study`).
 //!
 //! Must never: allocate in [`BrushParams::forces`], or return a non-finite
 //! force for finite inputs.
@@ -33,6 +34,7 @@ mod carcass;
 mod contact;
 mod params;
 mod solver;
+mod study;
 pub(crate) mod transient;
 
 pub use carcass::StringCarcass;
@@ -41,6 +43,10 @@ pub use params::{cpy_for, BrushParams, Derivation, BRUSH_KEYS, DEFAULT_POINTS, S
 pub use solver::{
     cornering_stiffness_on, evaluate_on, friction, slip_stiffness_on, BrushForces, BrushInput,
     Patch, M_MAX,
+};
+pub use study::{
+    cy_at, cy_elasticity, sensitivity, string_cornering_stiffness, StudyRow, VerticalSeries,
+    BETA_MIN, STUDY_FACTORS,
 };
 
 /// Which steady-state force model a transient model (or `eval`, the FMU) uses.

@@ -5,7 +5,7 @@ use crate::bench::{BenchContext, SECTIONS};
 /// Arguments of `tyrekit bench`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Areas to run (mf, fmu, transient, fit, diagnose, data); all when empty.
+    /// Areas to run (mf, fmu, transient, brush, fit, diagnose, data); all when empty.
     pub areas: Vec<String>,
     /// Python interpreter for the peers (default: .venv/bin/python if present, else python3).
     #[arg(long)]

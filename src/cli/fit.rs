@@ -145,21 +145,7 @@ pub fn run(args: Args) -> Result<()> {
         let (b0, _) = crate::brush::BrushParams::from_tyre(&mf)?;
         let bf = crate::fit::brush::fit_brush(&recs, b0)?;
         bf.params.write_to(&mut res.tyre);
-        let mode = crate::mf::UseMode::default();
-        let (mfy, mmz, mfx) = crate::fit::brush::pure_slip_sigmas(&recs, &|fz, k, t, p| {
-            let f = mf.forces(
-                &crate::mf::MfInput {
-                    fz,
-                    kappa: k,
-                    alpha: t.atan(),
-                    p,
-                    vx: 10.0,
-                    ..Default::default()
-                },
-                mode,
-            );
-            (f.fx, f.fy, f.mz)
-        });
+        let (mfy, mmz, mfx) = crate::fit::brush::mf_pure_slip_sigmas(&recs, &mf);
         println!(
             "brush fit ({} side-slip, {} longitudinal samples at |gamma| <= 0.5 deg, {} LM iterations): CPY {:.4e} N/m2, CPX {:.4e} N/m2, CARCASS_COMPLIANCE {:.4e} m/N, SIGMA_C {:.3} m, MUK {:.3}, MU_DFZ {:.3}",
             bf.n_lateral, bf.n_longitudinal, bf.iterations, bf.params.cpy, bf.params.cpx,

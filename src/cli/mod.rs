@@ -6,6 +6,7 @@
 use clap::{Parser, Subcommand};
 
 pub mod bench;
+pub mod brush;
 pub mod data;
 pub mod demo;
 pub mod diagnose;
@@ -43,6 +44,9 @@ pub enum Command {
     Replay(replay::Args),
     /// Explain why simulation and recording differ.
     Diagnose(diagnose::Args),
+    /// The brush model's studies (`tyrekit brush study`).
+    #[command(subcommand)]
+    Brush(brush::Command),
 }
 
 /// Load a `.tir` for a command: [`Tyre::from_file`](crate::mf::Tyre::from_file)
@@ -78,6 +82,7 @@ pub fn main() -> i32 {
         Command::Data(c) => data::run(c),
         Command::Fit(a) => fit::run(a),
         Command::Replay(a) => replay::run(a),
+        Command::Brush(c) => brush::run(c),
         Command::Diagnose(a) => diagnose::run(a),
     };
     match result {

@@ -43,8 +43,11 @@ struct Pt {
     fx: f64,
     fy: f64,
     mz: f64,
-    /// Inflation pressure (Pa; for the MF comparison, the brush has none).
+    /// Inflation pressure (Pa), inclination (rad) and speed (m/s): for the MF
+    /// comparison only (the brush has none of these terms).
     p: f64,
+    gamma: f64,
+    vx: f64,
 }
 
 /// The result of a brush fit.
@@ -162,6 +165,8 @@ fn select(recs: &[Recording]) -> Vec<Pt> {
                 fy: s.fy,
                 mz: s.mz,
                 p: s.p,
+                gamma: s.gamma,
+                vx: s.vx,
             });
         }
     }
@@ -188,11 +193,41 @@ pub fn pure_slip_sigmas(
     recs: &[Recording],
     eval: &dyn Fn(f64, f64, f64, f64) -> (f64, f64, f64),
 ) -> (f64, f64, f64) {
+    sigmas_by(recs, |p| eval(p.fz, p.kappa, p.tan_alpha, p.p))
+}
+
+/// σ of Fy, Mz, Fx of the Magic Formula `tyre` over the samples [`fit_brush`]
+/// uses, evaluated as the MF fit evaluates a sample (its own γ, Vx and p, the
+/// fit's use mode [`super::mf_stages::USE_MODE`]), so the figure is the MF
+/// fit's own on that subset. (An earlier comparison evaluated at γ = 0,
+/// Vx = 10 m/s with range limits on against a start file whose ranges the
+/// fit (then in use mode 211) had not widened: TyreData's 69–97 kPa were
+/// clamped to the built-in PRESMIN 186 kPa, and σ_Fy read 12.3 % for an MF
+/// the fit scored at 3.8 %.)
+pub fn mf_pure_slip_sigmas(recs: &[Recording], tyre: &crate::mf::Tyre) -> (f64, f64, f64) {
+    sigmas_by(recs, |p| {
+        let f = tyre.forces(
+            &crate::mf::MfInput {
+                fz: p.fz,
+                kappa: p.kappa,
+                alpha: p.tan_alpha.atan(),
+                gamma: p.gamma,
+                vx: p.vx,
+                p: p.p,
+                ..Default::default()
+            },
+            super::mf_stages::USE_MODE,
+        );
+        (f.fx, f.fy, f.mz)
+    })
+}
+
+fn sigmas_by(recs: &[Recording], eval: impl Fn(&Pt) -> (f64, f64, f64)) -> (f64, f64, f64) {
     let pts = select(recs);
     let (mut sy, mut ty, mut sm, mut tm, mut sx, mut tx) =
         (vec![], vec![], vec![], vec![], vec![], vec![]);
     for p in &pts {
-        let (fx, fy, mz) = eval(p.fz, p.kappa, p.tan_alpha, p.p);
+        let (fx, fy, mz) = eval(p);
         match p.set {
             Set::Lateral => {
                 sy.push(fy);

@@ -30,9 +30,7 @@ pub fn run(args: Args) -> crate::Result<()> {
         ..Default::default()
     })?;
     println!("packaged {}", fmu_path.display());
-    let dir = packaging::target_dir()
-        .join("fmu")
-        .join(format!("demo-{}", std::process::id()));
+    let dir = packaging::scratch_dir("demo");
     let result = simulate(&fmu_path, &dir, &args);
     let _ = std::fs::remove_dir_all(&dir);
     result
@@ -40,6 +38,10 @@ pub fn run(args: Args) -> crate::Result<()> {
 
 fn simulate(fmu_path: &std::path::Path, dir: &std::path::Path, args: &Args) -> crate::Result<()> {
     let fmu = Fmu::open(fmu_path, dir)?;
+    println!(
+        "FMU library: {}",
+        packaging::EMBEDDED_BUILD
+    );
     let cb = callbacks();
     let outs = [vr::FX, vr::FY, vr::MZ, vr::MX, vr::KAPPA, vr::ALPHA, vr::RE];
     let mut y = [0.0; 7];
@@ -56,12 +58,7 @@ fn simulate(fmu_path: &std::path::Path, dir: &std::path::Path, args: &Args) -> c
         "t [s]", "alpha[deg]", "Fy [N]", "Mz [N m]", "Mx [N m]", "Fx [N]"
     );
     let s = fmu.slave("slip_angle_ramp", &cb, &[])?;
-    let mut r0 = [0.0];
-    s.set_real(&[vr::VX, vr::FZ], &[args.vx, args.fz])?;
-    s.get_real(&[vr::R0], &mut r0)?;
-    let omega = args.vx / r0[0];
-    s.set_real(&[vr::VY, vr::OMEGA], &[0.0, omega])?;
-    s.exit_initialization()?;
+    let omega = free_rolling_omega(&s, args)?;
     for k in 0..=n {
         let t = k as f64 * h;
         let a = (12.0f64).to_radians() * t / (h * n as f64);
@@ -109,4 +106,20 @@ fn simulate(fmu_path: &std::path::Path, dir: &std::path::Path, args: &Args) -> c
         }
     }
     Ok(())
+}
+
+/// Initialise `s` at the demo's `vx` and `Fz` rolling freely (κ = 0) and
+/// return that spin rate. The FMU starts free rolling at FNOMIN and its start
+/// vx; ω is rescaled to the demo's vx, and after initialisation (outputs = the
+/// start inputs) corrected with the Re the FMU reports at the demo's load (Re
+/// depends on Ω only through the centrifugal growth, so |κ| is then ~1e-6).
+fn free_rolling_omega(s: &crate::fmi::master::Slave, args: &Args) -> crate::Result<f64> {
+    let mut start = [0.0; 2];
+    s.get_real(&[vr::VX, vr::OMEGA], &mut start)?;
+    let guess = start[1] * args.vx / start[0];
+    s.set_real(&[vr::VX, vr::FZ, vr::VY, vr::OMEGA], &[args.vx, args.fz, 0.0, guess])?;
+    s.exit_initialization()?;
+    let mut re = [0.0];
+    s.get_real(&[vr::RE], &mut re)?;
+    Ok(args.vx / re[0])
 }

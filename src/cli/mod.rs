@@ -6,11 +6,13 @@
 use clap::{Parser, Subcommand};
 
 pub mod bench;
+pub mod completions;
 pub mod data;
 pub mod demo;
 pub mod diagnose;
 pub mod eval;
 pub mod fit;
+pub mod manners;
 pub mod package;
 pub mod provenance;
 pub mod replay;
@@ -43,6 +45,8 @@ pub enum Command {
     Replay(replay::Args),
     /// Explain why simulation and recording differ.
     Diagnose(diagnose::Args),
+    /// Print a shell completion script (bash, zsh, fish, …) on stdout.
+    Completions(completions::Args),
 }
 
 /// Load a `.tir` for a command: [`Tyre::from_file`](crate::mf::Tyre::from_file)
@@ -79,6 +83,7 @@ pub fn main() -> i32 {
         Command::Fit(a) => fit::run(a),
         Command::Replay(a) => replay::run(a),
         Command::Diagnose(a) => diagnose::run(a),
+        Command::Completions(a) => completions::run(a),
     };
     match result {
         Ok(()) => 0,

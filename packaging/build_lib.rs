@@ -94,7 +94,9 @@ pub fn embed(guid: &str) {
             c
         }
     };
-    cmd.args(["--release", "--lib", "--quiet", "--manifest-path"])
+    // Only the library and what it needs: the binary-only dependencies (feature
+    // `cli`: clap, zip, indicatif) are not compiled for it.
+    cmd.args(["--release", "--lib", "--no-default-features", "--quiet", "--manifest-path"])
         .arg(root.join("Cargo.toml"))
         .arg("--target-dir")
         .arg(&target_dir);

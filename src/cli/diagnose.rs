@@ -169,6 +169,9 @@ pub fn run(a: Args) -> Result<()> {
     let text = serde_json::to_string_pretty(&report)
         .map_err(|e| Error::Other(format!("diagnosis.json: {e}")))?;
     std::fs::write(&jp, text).map_err(|e| Error::io(&jp, e))?;
+    // The --json result: diagnosis.json's content plus where the page is.
+    let mut json =
+        serde_json::to_value(&report).map_err(|e| Error::Other(format!("diagnosis.json: {e}")))?;
     json["report_html"] = serde_json::to_value(a.report.join("report.html")).unwrap_or_default();
     let hp = a.report.join("report.html");
     std::fs::write(&hp, html::page(&d, &pl, &rec.source, &note)).map_err(|e| Error::io(&hp, e))?;

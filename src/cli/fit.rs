@@ -199,7 +199,9 @@ pub fn run(args: Args) -> Result<()> {
     tyre.write(&args.out)?;
     let m = &args.manners;
     if let Some(g) = &res.geometry {
-        m.say(g.trim_end());
+        for l in g.lines() {
+            m.say(l);
+        }
     }
     m.say(res.report.to_text().trim_end());
     m.say(format_args!("wrote {}", args.out.display()));

@@ -47,13 +47,27 @@ fn fail(msg: String) -> ! {
 /// `OUT_DIR/fmu_lib.txt` (how it was built). No-op inside the nested build.
 pub fn embed(guid: &str) {
     println!("cargo:rerun-if-env-changed=TYREKIT_FMU_BUILD");
-    println!("cargo:rerun-if-changed=src");
+    // The library's sources: everything under src/ but the binary's own
+    // files (src/main.rs, src/cli, src/bench), so editing the command line
+    // does not rebuild the embedded library.
+    let root = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("CARGO_MANIFEST_DIR"));
+    let binary_only = ["main.rs", "cli", "bench"];
+    match std::fs::read_dir(root.join("src")) {
+        Ok(entries) => {
+            for e in entries.flatten() {
+                let name = e.file_name();
+                if !binary_only.iter().any(|b| name == *b) {
+                    println!("cargo:rerun-if-changed=src/{}", name.to_string_lossy());
+                }
+            }
+        }
+        Err(_) => println!("cargo:rerun-if-changed=src"),
+    }
     println!("cargo:rerun-if-changed=Cargo.toml");
     println!("cargo:rerun-if-changed=Cargo.lock");
     if std::env::var_os("TYREKIT_NESTED_LIB_BUILD").is_some() {
         return;
     }
-    let root = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").expect("CARGO_MANIFEST_DIR"));
     let out_dir = PathBuf::from(std::env::var("OUT_DIR").expect("OUT_DIR"));
     // The cargo target directory is the ancestor of OUT_DIR holding CACHEDIR.TAG.
     let target_dir = out_dir

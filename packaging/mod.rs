@@ -248,8 +248,11 @@ pub fn package(opts: &Options) -> Result<PathBuf> {
         let deflate = zip::write::SimpleFileOptions::default()
             .compression_method(zip::CompressionMethod::Deflated)
             .unix_permissions(0o644);
-        let entries: [(String, &[u8]); 4] = [
+        let entries: [(String, &[u8]); 5] = [
             ("modelDescription.xml".into(), xml.as_bytes()),
+            // The instance reads its chosen start values (force_model) here:
+            // masters such as fmpy extract only binaries/ and resources/.
+            ("resources/modelDescription.xml".into(), xml.as_bytes()),
             (format!("binaries/linux64/{MODEL_IDENTIFIER}.so"), &so),
             ("resources/tyre.tir".into(), &tir_text),
             ("documentation/index.html".into(), doc.as_bytes()),

@@ -98,7 +98,8 @@ fn unknown_chosen_start_in_the_packaged_xml_is_an_error() {
     let r = tyrekit::fmi::start::start_span(&x, "force_model").unwrap();
     let mut bad = x.clone();
     bad.replace_range(r, "magic");
-    std::fs::write(root.join("modelDescription.xml"), bad).unwrap();
+    // The instance reads the copy in resources/ (what fmpy extracts).
+    std::fs::write(root.join("resources").join("modelDescription.xml"), bad).unwrap();
     let loc = root.join("resources");
     let Err((_, e)) = Instance::new(Logger::new(None, "t", false), Some(loc.to_str().unwrap()))
     else {

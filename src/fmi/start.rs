@@ -92,18 +92,19 @@ pub fn start_span(xml: &str, name: &str) -> Option<Range<usize>> {
 }
 
 /// The chosen start values (`spec::CHOSEN_STARTS`) of the FMU whose
-/// resources folder is `resources`, from `resources/../modelDescription.xml`.
+/// resources folder is `resources`, from `resources/modelDescription.xml` (the
+/// packaged copy) or else `resources/../modelDescription.xml`.
 /// Empty when that file is absent or belongs to another interface (another
 /// GUID: e.g. a master that passes a bare folder): the built-in XML's starts
 /// apply. An error names the file when it is ours but unreadable or holds a
 /// value the library does not know.
 pub fn read_chosen(resources: &Path) -> Result<Vec<ChosenStart>, String> {
-    let Some(path) = resources.parent().map(|d| d.join("modelDescription.xml")) else {
+    // Packaging puts a copy in resources/ (fmpy's simulate_fmu extracts only
+    // binaries/ and resources/); the FMU root's is the fallback.
+    let candidates = [Some(resources.join("modelDescription.xml")), resources.parent().map(|d| d.join("modelDescription.xml"))];
+    let Some(path) = candidates.into_iter().flatten().find(|p| p.is_file()) else {
         return Ok(Vec::new());
     };
-    if !path.is_file() {
-        return Ok(Vec::new());
-    }
     let xml = std::fs::read_to_string(&path)
         .map_err(|e| format!("{}: cannot read the packaged modelDescription.xml: {e}", path.display()))?;
     if !xml.contains(&format!("guid=\"{GUID}\"")) {

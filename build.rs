@@ -11,10 +11,15 @@
 //!
 //! The GUID is a hash of the interface (model identifier and every variable's
 //! name, value reference, type, causality, variability, initial, start and unit):
-//! it changes exactly when the interface changes.
+//! it changes exactly when the interface changes. The start values of
+//! `spec::TYRE_DEPENDENT_STARTS` (`Fz`, `omega`) and `spec::CHOSEN_STARTS`
+//! (`force_model`) are left out: `tyrekit package` sets them from the packaged
+//! tyre and its options, and one library serves every packaged FMU.
 //!
-//! Must never: read anything but the XML and spec.rs, or produce code that
-//! allocates.
+//! It also builds the FMU's shared library for the `tyrekit` binary to embed
+//! (`packaging/build_lib.rs`, a nested cargo run over this package's library).
+//! Must never: read anything but the XML and spec.rs (besides that nested
+//! build), or produce code that allocates.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
@@ -22,6 +27,9 @@ use std::fmt::Write as _;
 #[path = "src/fmi/spec.rs"]
 #[allow(dead_code)]
 mod spec;
+
+#[path = "packaging/build_lib.rs"]
+mod build_lib;
 
 const XML_PATH: &str = "modelDescription/modelDescription.xml";
 const GUID_PLACEHOLDER: &str = "@GUID@";
@@ -392,71 +400,69 @@ fn main() {
         }
     }
 
-    // GUID from the interface.
-    // A start value is part of the interface: a variant XML with another
-    // start value of a parameter (spec::START_VARIANTS, what `tyrekit package`
-    // may set) has its own GUID, which this binary also knows.
-    let guid_with = |over: Option<(&str, &str)>| {
-        let mut canon = format!("fmi2|{model_identifier}\n");
-        for v in &vars {
-            let start = match over {
-                Some((n, s)) if n == v.name => s,
-                _ => v.start.as_deref().unwrap_or(""),
-            };
-            let _ = writeln!(
-                canon,
-                "{}|{}|{}|{}|{}|{}|{}|{}",
-                v.name,
-                v.vr,
-                v.ty,
-                v.causality,
-                v.variability,
-                v.initial.as_deref().unwrap_or(""),
-                start,
-                v.unit.as_deref().unwrap_or("")
-            );
-        }
-        let h1 = fnv1a(canon.as_bytes(), 0xcbf2_9ce4_8422_2325);
-        let h2 = fnv1a(canon.as_bytes(), 0x84222325_cbf29ce4 ^ h1);
-        format!(
-            "{{{:08x}-{:04x}-{:04x}-{:04x}-{:012x}}}",
-            h1 >> 32,
-            (h1 >> 16) & 0xffff,
-            h1 & 0xffff,
-            h2 >> 48,
-            h2 & 0xffff_ffff_ffff
-        )
-    };
-    let guid = guid_with(None);
-    let final_xml = text.replacen(GUID_PLACEHOLDER, &guid, 1);
-    let mut variants = Vec::new();
-    for (name, values) in spec::START_VARIANTS {
-        let v = vars
-            .iter()
-            .find(|v| v.name == *name)
-            .unwrap_or_else(|| fail(format!("spec::START_VARIANTS names {name}, not a variable")));
-        let at = text
-            .find(&format!("name=\"{name}\""))
-            .unwrap_or_else(|| fail(format!("{name}: not found in the XML text")));
-        let old = format!("start=\"{}\"", v.start.as_deref().unwrap_or(""));
-        let rel = text[at..]
-            .find(&old)
-            .unwrap_or_else(|| fail(format!("line {}: {name} has no start attribute", v.line)));
-        for value in values.iter() {
-            let mut x = text.clone();
-            x.replace_range(
-                at + rel..at + rel + old.len(),
-                &format!("start=\"{value}\""),
-            );
-            let g = guid_with(Some((name, value)));
-            variants.push((
-                name.to_string(),
-                value.to_string(),
-                g.clone(),
-                x.replacen(GUID_PLACEHOLDER, &g, 1),
-            ));
+    // Tyre-dependent start values: Real inputs with a start value (packaging
+    // rewrites it), left out of the GUID.
+    for name in spec::TYRE_DEPENDENT_STARTS {
+        match vars.iter().find(|v| v.name == *name) {
+            Some(v) if v.ty == "Real" && v.causality == "input" && v.start.is_some() => {}
+            _ => fail(format!(
+                "\"{name}\" (spec::TYRE_DEPENDENT_STARTS) must be a Real input with a start value"
+            )),
         }
     }
+    // Chosen start values: String parameters whose start `tyrekit package`
+    // picks from a fixed list (the XML's must be one of them), also left out.
+    for (name, allowed) in spec::CHOSEN_STARTS {
+        match vars.iter().find(|v| v.name == *name) {
+            Some(v)
+                if v.ty == "String"
+                    && v.causality == "parameter"
+                    && v.start.as_deref().is_some_and(|s| allowed.contains(&s)) => {}
+            _ => fail(format!(
+                "\"{name}\" (spec::CHOSEN_STARTS) must be a String parameter whose start is one of {allowed:?}"
+            )),
+        }
+    }
+    fn start_in_guid(v: &Var) -> &str {
+        if spec::TYRE_DEPENDENT_STARTS.contains(&v.name.as_str()) {
+            "tyre"
+        } else if spec::CHOSEN_STARTS.iter().any(|(n, _)| *n == v.name) {
+            "chosen"
+        } else {
+            v.start.as_deref().unwrap_or("")
+        }
+    }
+
+    // GUID from the interface.
+    let mut canon = format!("fmi2|{model_identifier}\n");
+    for v in &vars {
+        let _ = writeln!(
+            canon,
+            "{}|{}|{}|{}|{}|{}|{}|{}",
+            v.name,
+            v.vr,
+            v.ty,
+            v.causality,
+            v.variability,
+            v.initial.as_deref().unwrap_or(""),
+            start_in_guid(v),
+            v.unit.as_deref().unwrap_or("")
+        );
+    }
+    let h1 = fnv1a(canon.as_bytes(), 0xcbf2_9ce4_8422_2325);
+    let h2 = fnv1a(canon.as_bytes(), 0x84222325_cbf29ce4 ^ h1);
+    let guid = format!(
+        "{{{:08x}-{:04x}-{:04x}-{:04x}-{:012x}}}",
+        h1 >> 32,
+        (h1 >> 16) & 0xffff,
+        h1 & 0xffff,
+        h2 >> 48,
+        h2 & 0xffff_ffff_ffff
+    );
+    let final_xml = text.replacen(GUID_PLACEHOLDER, &guid, 1);
+    // The FMU's shared library, for the binary to embed (packaging/build_lib.rs).
+    println!("cargo:rerun-if-changed=packaging/build_lib.rs");
+    build_lib::embed(&guid);
 
     // Generated Rust.
     let mut out = String::new();
@@ -482,18 +488,6 @@ fn main() {
         out,
         "pub const MODEL_DESCRIPTION_XML: &str = include_str!(concat!(env!(\"OUT_DIR\"), \"/modelDescription.xml\"));"
     );
-    let _ = writeln!(
-        out,
-        "/// Variants of the interface with another start value of a parameter\n/// (name, start value, GUID, modelDescription.xml): spec::START_VARIANTS."
-    );
-    let _ = writeln!(
-        out,
-        "pub const START_VARIANTS: &[(&str, &str, &str, &str)] = &["
-    );
-    for (n, v, g, x) in &variants {
-        let _ = writeln!(out, "    ({n:?}, {v:?}, {g:?}, {x:?}),");
-    }
-    let _ = writeln!(out, "];");
     let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
     let mut slots = Vec::new();
     for v in &vars {

@@ -6,12 +6,14 @@
 //! recordings ([`data`]) → ISO-W SI samples → model ([`tir`], [`mf`], [`transient`])
 //! → residuals ([`fit`]) → report ([`diagnose`]).
 //!
+//! The command line, the benchmarks, the FMU packaging and the small FMU
+//! importer of `demo`/`bench` are the binary's (`src/main.rs`): this library is
+//! what the FMU's shared library (cdylib) is built from.
+//!
 //! Conventions: ISO-W (TYDEX W) axes and SI units everywhere inside the crate.
 //! Conversions happen only at the edges (`.tir` `[UNITS]`, SAE/TTC recordings).
 
-pub mod bench;
 pub mod brush;
-pub mod cli;
 pub mod data;
 pub mod diagnose;
 pub mod error;

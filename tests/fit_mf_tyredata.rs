@@ -51,7 +51,7 @@ fn tyredata_fy_mz_fit_and_tir_reload() {
     let dir = std::env::temp_dir().join(format!("tyrekit_fit_mf_td_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let fitted = Tyre::new(res.tyre.clone()).unwrap();
-    let plots = tyrekit::cli::fit::plot_fit(&fitted, &recs[0], &opts.only, &dir).unwrap();
+    let plots = tyrekit::fit::plot::plot_fit(&fitted, &recs[0], &opts.only, &dir).unwrap();
     assert!(
         plots.len() >= 2,
         "expected plots of Fy and Mz per condition"

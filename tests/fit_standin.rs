@@ -2,7 +2,10 @@
 //! synthetic data from a different starting tyre: every parameter comes back
 //! within a few standard errors of the truth, and the cost matches the noise.
 
-use tyrekit::bench::fit::{LateralData, LateralStandIn, FZ0, TRUTH};
+#[path = "fit_support/standin.rs"]
+#[allow(dead_code)]
+mod standin;
+use standin::{LateralData, LateralStandIn, FZ0, TRUTH};
 use tyrekit::fit::{fit, FitOptions, ParamStatus};
 
 #[test]

@@ -6,21 +6,23 @@ use fmi::fmi2::import::Fmi2Import;
 use fmi::fmi2::instance::{CoSimulation, Common};
 use fmi::traits::FmiImport;
 use std::path::PathBuf;
-use tyrekit::fmi::packaging;
 use tyrekit::mf::Tyre;
 use tyrekit::transient::{TransientConfig, TransientModel, WheelInput};
 
-/// A freshly packaged FMU of this build (own path: tests run in parallel).
+/// A freshly packaged FMU of this build, written by `tyrekit package` as a user
+/// would (own path: tests run in parallel).
 fn fmu(name: &str) -> PathBuf {
-    let out = packaging::target_dir()
-        .join("fmu")
+    let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
         .join(format!("import-test-{name}"))
         .join("TyreKit.fmu");
-    packaging::package(&packaging::Options {
-        out: Some(out),
-        ..Default::default()
-    })
-    .expect("packaging the FMU")
+    let st = std::process::Command::new(env!("CARGO_BIN_EXE_tyrekit"))
+        .arg("package")
+        .arg("--out")
+        .arg(&out)
+        .status()
+        .expect("running tyrekit package");
+    assert!(st.success(), "tyrekit package failed");
+    out
 }
 
 fn vr(import: &Fmi2Import, name: &str) -> u32 {

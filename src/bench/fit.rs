@@ -24,10 +24,6 @@ use crate::tir::TyreParams;
 use rand::{Rng, SeedableRng};
 use std::time::Instant;
 
-#[path = "fit_standin.rs"]
-mod standin;
-pub use standin::*;
-
 /// The benchmark data: inputs, noisy and noise-free Fy.
 pub struct BenchData {
     pub inputs: Vec<MfInput>,

@@ -103,9 +103,7 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
         ),
         ..Default::default()
     })?;
-    let dir = packaging::target_dir()
-        .join("fmu")
-        .join(format!("bench-{}", std::process::id()));
+    let dir = packaging::scratch_dir("bench");
     let result = (|| -> crate::Result<()> {
         let fmu = Fmu::open(&fmu_path, &dir)?;
         for kind in [

@@ -18,12 +18,14 @@ use crate::mf::Tyre;
 use crate::residual::ReplayOptions;
 use crate::{Error, Result};
 use indicatif::{ProgressBar, ProgressStyle};
-use std::io::IsTerminal;
 use std::path::PathBuf;
 
 /// Arguments of `tyrekit diagnose`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
+    /// --json, --quiet, --threads.
+    #[command(flatten)]
+    pub manners: super::manners::Manners,
     /// Recordings (TTC .mat/.dat, TYDEX, CSV); merged with a gap between them.
     #[arg(required = true)]
     pub recordings: Vec<PathBuf>,
@@ -42,8 +44,8 @@ pub struct Args {
     pub read: crate::cli::data::RecordingArgs,
 }
 
-fn bar(len: u64, template: &str) -> Option<ProgressBar> {
-    std::io::stderr().is_terminal().then(|| {
+fn bar(m: &super::manners::Manners, len: u64, template: &str) -> Option<ProgressBar> {
+    m.progress().then(|| {
         let b = ProgressBar::new(len);
         b.set_style(
             ProgressStyle::with_template(template).unwrap_or_else(|_| ProgressStyle::default_bar()),
@@ -86,7 +88,7 @@ pub fn run(a: Args) -> Result<()> {
             format!("Baseline: {} (given with --tir).", tir.display()),
         ),
         _ => {
-            let b = bar(100, "{prefix:>12} [{bar:30}] {pos}/{len} {msg}");
+            let b = bar(&a.manners, 100, "{prefix:>12} [{bar:30}] {pos}/{len} {msg}");
             let mut cb = |p: &Progress| {
                 if let Some(b) = &b {
                     b.set_prefix(format!("fit {}", p.stage));
@@ -95,7 +97,7 @@ pub fn run(a: Args) -> Result<()> {
                     b.set_message(format!("cost {:.4e}", p.cost));
                 }
             };
-            let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+            let threads = a.manners.threads();
             let fit = fit_baseline(&recs, threads, Some(&mut cb))?;
             if let Some(b) = &b {
                 b.finish_and_clear();
@@ -133,9 +135,10 @@ pub fn run(a: Args) -> Result<()> {
             (Tyre::new(fit.tyre)?, note)
         }
     };
-    println!("{note}");
+    let m = &a.manners;
+    m.say(&note);
     let rec = merge(recs);
-    let steps = bar(3, "{prefix:>12} [{bar:30}] {pos}/{len} {msg} {elapsed}");
+    let steps = bar(m, 3, "{prefix:>12} [{bar:30}] {pos}/{len} {msg} {elapsed}");
     if let Some(b) = &steps {
         b.set_prefix("diagnose");
     }
@@ -166,26 +169,31 @@ pub fn run(a: Args) -> Result<()> {
     let text = serde_json::to_string_pretty(&report)
         .map_err(|e| Error::Other(format!("diagnosis.json: {e}")))?;
     std::fs::write(&jp, text).map_err(|e| Error::io(&jp, e))?;
+    // The --json result: diagnosis.json's content plus where the page is.
+    let mut json =
+        serde_json::to_value(&report).map_err(|e| Error::Other(format!("diagnosis.json: {e}")))?;
+    json["report_html"] = serde_json::to_value(a.report.join("report.html")).unwrap_or_default();
     let hp = a.report.join("report.html");
     std::fs::write(&hp, html::page(&d, &pl, &rec.source, &note)).map_err(|e| Error::io(&hp, e))?;
-    println!("verdict: {}", d.verdict);
-    println!("{}", d.explanation);
+    m.say(format_args!("verdict: {}", d.verdict));
+    m.say(&d.explanation);
     for r in d.out_of_sample.iter().filter(|r| r.condition == "all") {
-        println!(
+        m.say(format_args!(
             "  held out {}: σ {:.2} % -> {:.2} %, NRMSE {:.2} % -> {:.2} %",
             r.channel.name(),
             100.0 * r.sigma_before,
             100.0 * r.sigma_after,
             100.0 * r.nrmse_before,
             100.0 * r.nrmse_after
-        );
+        ));
     }
-    println!(
+    m.say(format_args!(
         "wrote {} ({} plots), {}, baseline.tir, extended.tir in {:.1} s",
         hp.display(),
         pl.len(),
         jp.display(),
         t0.elapsed().as_secs_f64()
-    );
+    ));
+    m.result(&json)?;
     Ok(())
 }

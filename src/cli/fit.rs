@@ -6,21 +6,22 @@
 //! Must never: overwrite the start file unless `--out` names it, panic on
 //! user data, or draw progress when stderr is not a terminal.
 
-use crate::data::{Recording, SegmentKind};
-use crate::fit::metrics::Condition;
+use crate::data::Recording;
 use crate::fit::mf_fit::{fit_mf, MfFitOptions};
-use crate::fit::mf_stages::{Channel, StageKind, FIT_MODE};
+use crate::fit::mf_stages::StageKind;
+use crate::fit::plot::plot_fit;
 use crate::fit::{Holdout, Progress};
-use crate::mf::{MfInput, Tyre};
+use crate::mf::Tyre;
 use crate::tir::{MfVersion, TyreParams};
 use crate::{Error, Result};
-use plotters::prelude::*;
-use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Arguments of `tyrekit fit`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
+    /// --json, --quiet, --threads.
+    #[command(flatten)]
+    pub manners: super::manners::Manners,
     /// Recordings (any format `tyrekit data` reads).
     #[arg(required = true)]
     pub recordings: Vec<PathBuf>,
@@ -70,6 +71,7 @@ fn parse_model(s: &str) -> Result<MfVersion> {
 pub fn run(args: Args) -> Result<()> {
     let mut opts = MfFitOptions {
         holdout: Holdout::parse(&args.holdout)?,
+        threads: args.manners.threads(),
         ..Default::default()
     };
     if !args.only.is_empty() {
@@ -117,7 +119,7 @@ pub fn run(args: Args) -> Result<()> {
         .collect();
     let recs: Vec<Recording> = loaded.into_iter().map(|l| l.recording).collect();
 
-    let bar = std::io::stderr().is_terminal().then(|| {
+    let bar = args.manners.progress().then(|| {
         let b = indicatif::ProgressBar::new(100);
         b.set_style(
             indicatif::ProgressStyle::with_template("{prefix:>10} [{bar:30}] {pos}/{len} {msg}")
@@ -146,17 +148,18 @@ pub fn run(args: Args) -> Result<()> {
         let bf = crate::fit::brush::fit_brush(&recs, b0)?;
         bf.params.write_to(&mut res.tyre);
         let (mfy, mmz, mfx) = crate::fit::brush::mf_pure_slip_sigmas(&recs, &mf);
-        println!(
+        args.manners.say(format_args!(
             "brush fit ({} side-slip, {} longitudinal samples at |gamma| <= 0.5 deg, {} LM iterations): CPY {:.4e} N/m2, CPX {:.4e} N/m2, CARCASS_COMPLIANCE {:.4e} m/N, SIGMA_C {:.3} m, MUK {:.3}, MU_DFZ {:.3}",
             bf.n_lateral, bf.n_longitudinal, bf.iterations, bf.params.cpy, bf.params.cpx,
             bf.params.compliance, bf.params.sigma_c, bf.params.mu_k, bf.params.mu_dfz
-        );
-        println!("pure slip   sigma_Fy  sigma_Mz  sigma_Fx");
-        println!(
+        ));
+        args.manners.say("pure slip   sigma_Fy  sigma_Mz  sigma_Fx");
+        args.manners.say(format_args!(
             "brush       {:8.4}  {:8.4}  {:8.4}",
             bf.sigma_fy, bf.sigma_mz, bf.sigma_fx
-        );
-        println!("MF          {mfy:8.4}  {mmz:8.4}  {mfx:8.4}");
+        ));
+        args.manners
+            .say(format_args!("MF          {mfy:8.4}  {mmz:8.4}  {mfx:8.4}"));
     }
     // The fitted tyre passes the same validation as any loaded one before
     // it is written (a refusal is an error; doubts are shown).
@@ -184,13 +187,14 @@ pub fn run(args: Args) -> Result<()> {
     inputs.extend(args.start.iter().cloned());
     crate::cli::provenance::stamp_fit(&mut tyre, &inputs, &res)?;
     tyre.write(&args.out)?;
+    let m = &args.manners;
     if let Some(g) = &res.geometry {
         for l in g.lines() {
-            println!("{l}");
+            m.say(l);
         }
     }
-    print!("{}", res.report.to_text());
-    println!("wrote {}", args.out.display());
+    m.say(res.report.to_text().trim_end());
+    m.say(format_args!("wrote {}", args.out.display()));
     if let Some(dir) = &args.report {
         std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
         res.report.write_json(&dir.join("fit.json"))?;
@@ -199,150 +203,17 @@ pub fn run(args: Args) -> Result<()> {
         for rec in &recs {
             n += plot_fit(&tyre, rec, &opts.only, dir)?.len();
         }
-        println!("wrote {} and {n} plots", dir.join("fit.json").display());
+        m.say(format_args!(
+            "wrote {} and {n} plots",
+            dir.join("fit.json").display()
+        ));
     }
-    Ok(())
-}
-
-/// One SVG per (channel, condition): measured points and the model curve at
-/// the condition's set points over the slip range of the data.
-pub fn plot_fit(
-    tyre: &Tyre,
-    rec: &Recording,
-    stages: &[StageKind],
-    dir: &Path,
-) -> Result<Vec<PathBuf>> {
-    let mut out = Vec::new();
-    let stem = Path::new(&rec.source)
-        .file_stem()
-        .map_or("rec".into(), |s| s.to_string_lossy().into_owned());
-    for &kind in stages {
-        let (seg_kind, channels) = kind.segments_and_channels();
-        for &ch in channels {
-            if !rec.has(ch.name()) {
-                continue;
-            }
-            for cond in crate::fit::metrics::conditions(rec) {
-                let segs: Vec<_> = rec
-                    .segments
-                    .iter()
-                    .filter(|s| s.kind == seg_kind && Condition::of(s).same(&cond))
-                    .collect();
-                if segs.is_empty() {
-                    continue;
-                }
-                let lateral = seg_kind == SegmentKind::PureLateral;
-                let slip = |s: &crate::data::Sample| if lateral { s.alpha } else { s.kappa };
-                let mut pts = Vec::new();
-                for g in &segs {
-                    let step = (g.len() / 1500).max(1);
-                    for s in rec.samples[g.start..g.end.min(rec.samples.len())]
-                        .iter()
-                        .step_by(step)
-                    {
-                        let (x, y) = (slip(s), ch.measured(s));
-                        if x.is_finite() && y.is_finite() {
-                            pts.push((x, y));
-                        }
-                    }
-                }
-                if pts.len() < 2 {
-                    continue;
-                }
-                let (x0, x1) = pts
-                    .iter()
-                    .fold((f64::MAX, f64::MIN), |a, p| (a.0.min(p.0), a.1.max(p.0)));
-                let g0 = segs[0];
-                let curve: Vec<(f64, f64)> = (0..=200)
-                    .map(|k| {
-                        let x = x0 + (x1 - x0) * k as f64 / 200.0;
-                        let inp = MfInput {
-                            fz: cond.fz,
-                            gamma: cond.gamma,
-                            p: cond.p,
-                            vx: if g0.vx.is_finite() && g0.vx > 0.0 {
-                                g0.vx
-                            } else {
-                                10.0
-                            },
-                            alpha: if lateral { x } else { g0.alpha },
-                            kappa: if lateral { 0.0 } else { x },
-                            ..Default::default()
-                        };
-                        (x, ch.of_forces(&tyre.forces(&inp, FIT_MODE)))
-                    })
-                    .collect();
-                let name = format!(
-                    "{stem}_{}_{}_fz{:.0}_g{:.1}_p{:.0}.svg",
-                    kind.name().replace(' ', "_"),
-                    ch.name(),
-                    cond.fz,
-                    cond.gamma.to_degrees(),
-                    cond.p / 1e3
-                );
-                let path = dir.join(name);
-                draw(&path, ch, lateral, &pts, &curve, &cond)?;
-                out.push(path);
-            }
-        }
-    }
-    Ok(out)
-}
-
-fn draw(
-    path: &Path,
-    ch: Channel,
-    lateral: bool,
-    pts: &[(f64, f64)],
-    curve: &[(f64, f64)],
-    cond: &Condition,
-) -> Result<()> {
-    let perr =
-        |e: &dyn std::fmt::Display| Error::Other(format!("{}: cannot draw: {e}", path.display()));
-    let all = pts.iter().chain(curve);
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for &(x, y) in all {
-        if x.is_finite() && y.is_finite() {
-            x0 = x0.min(x);
-            x1 = x1.max(x);
-            y0 = y0.min(y);
-            y1 = y1.max(y);
-        }
-    }
-    let pad = |a: f64, b: f64| ((b - a) * 0.05).max(1e-9);
-    let (px, py) = (pad(x0, x1), pad(y0, y1));
-    let root = SVGBackend::new(path, (800, 560)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| perr(&e))?;
-    let caption = format!(
-        "{} vs {}: Fz {:.0} N, gamma {:.1} deg, P {:.0} kPa (grey data, red model)",
-        ch.name(),
-        if lateral { "alpha" } else { "kappa" },
-        cond.fz,
-        cond.gamma.to_degrees(),
-        cond.p / 1e3
-    );
-    let mut chart = ChartBuilder::on(&root)
-        .caption(caption, ("sans-serif", 16))
-        .margin(10)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d((x0 - px)..(x1 + px), (y0 - py)..(y1 + py))
-        .map_err(|e| perr(&e))?;
-    chart
-        .configure_mesh()
-        .x_desc(if lateral { "alpha [rad]" } else { "kappa [-]" })
-        .y_desc(if ch == Channel::Mz { "Nm" } else { "N" })
-        .draw()
-        .map_err(|e| perr(&e))?;
-    chart
-        .draw_series(
-            pts.iter()
-                .map(|&p| Circle::new(p, 1, RGBColor(150, 150, 150).filled())),
-        )
-        .map_err(|e| perr(&e))?;
-    chart
-        .draw_series(LineSeries::new(curve.iter().copied(), RED.stroke_width(2)))
-        .map_err(|e| perr(&e))?;
-    root.present().map_err(|e| perr(&e))?;
+    let report: serde_json::Value = serde_json::from_str(&res.report.to_json()?)
+        .map_err(|e| Error::Other(format!("fit report: {e}")))?;
+    m.result(&serde_json::json!({
+        "tir": args.out,
+        "skipped": res.skipped,
+        "report": report,
+    }))?;
     Ok(())
 }

@@ -7,11 +7,13 @@ use clap::{Parser, Subcommand};
 
 pub mod bench;
 pub mod brush;
+pub mod completions;
 pub mod data;
 pub mod demo;
 pub mod diagnose;
 pub mod eval;
 pub mod fit;
+pub mod manners;
 pub mod package;
 pub mod provenance;
 pub mod replay;
@@ -47,6 +49,8 @@ pub enum Command {
     /// The brush model's studies (`tyrekit brush study`).
     #[command(subcommand)]
     Brush(brush::Command),
+    /// Print a shell completion script (bash, zsh, fish, …) on stdout.
+    Completions(completions::Args),
 }
 
 /// Load a `.tir` for a command: [`Tyre::from_file`](crate::mf::Tyre::from_file)
@@ -84,6 +88,7 @@ pub fn main() -> i32 {
         Command::Replay(a) => replay::run(a),
         Command::Brush(c) => brush::run(c),
         Command::Diagnose(a) => diagnose::run(a),
+        Command::Completions(a) => completions::run(a),
     };
     match result {
         Ok(()) => 0,

@@ -46,6 +46,7 @@ pub mod loss;
 pub mod metrics;
 pub mod mf_fit;
 pub mod mf_stages;
+pub mod plot;
 pub mod problem;
 pub mod pso;
 pub mod recording;

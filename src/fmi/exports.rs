@@ -194,12 +194,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
             Ok(g) => g,
             Err(e) => return fail(&log, e),
         };
-        // The default interface, or a start-value variant `tyrekit package` wrote.
-        let variant = vars::START_VARIANTS
-            .iter()
-            .find(|v| v.2 == g)
-            .map(|v| (v.0, v.1));
-        if g != vars::GUID && variant.is_none() {
+        if g != vars::GUID {
             return fail(
                 &log,
                 format!(
@@ -216,7 +211,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
                 Err(_) => return fail(&log, "fmuResourceLocation is not valid UTF-8".into()),
             }
         };
-        match Instance::new_variant(log, loc, variant) {
+        match Instance::new(log, loc) {
             Ok(inst) => Box::into_raw(inst) as fmi2Component,
             Err((log, msg)) => fail(&log, msg),
         }

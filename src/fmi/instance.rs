@@ -153,16 +153,16 @@ pub struct Instance {
     /// resources/tyre.tir, loaded at instantiation (what fmi2Reset returns to).
     pub default_tyre: Loaded,
     pub sim: Sim,
-    /// The start-value variant of the interface the master instantiated
-    /// (its GUID named it; `vars::START_VARIANTS`), None for the default XML.
-    pub variant: Option<StartVariant>,
+    /// The start values `tyrekit package` chose for this FMU (read from the
+    /// packaged modelDescription.xml at instantiation; `fmi::start`).
+    pub chosen: Vec<ChosenStart>,
     /// Addresses of the FMU states (`Box<Snapshot>`) this instance created
     /// and the master has not freed: fmi2FreeInstance frees them.
     pub states: Vec<usize>,
 }
 
-/// A parameter's start value differing from the default XML: (name, value).
-pub type StartVariant = (&'static str, &'static str);
+/// A parameter's start value chosen at packaging (`spec::CHOSEN_STARTS`): (name, value).
+pub type ChosenStart = (&'static str, String);
 
 /// The settings derived from the parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -370,12 +370,13 @@ fn input_problem(slot: usize, x: f64) -> Option<String> {
 
 impl Sim {
     /// The state right after instantiation / reset.
-    fn initial(loaded: Loaded, variant: Option<StartVariant>) -> Result<Sim, String> {
+    fn initial(loaded: Loaded, chosen: &[ChosenStart]) -> Result<Sim, String> {
         let mut values = Values::start();
-        if let Some((name, value)) = variant {
-            // build.rs only generates variants of String parameters it knows.
+        super::start::apply(&mut values, &loaded.tyre);
+        for (name, value) in chosen {
+            // start::read_chosen only returns String parameters of spec::CHOSEN_STARTS.
             if let Some(v) = super::vars::by_name(name) {
-                values.strings[v.slot] = std::ffi::CString::new(value).unwrap_or_default();
+                values.strings[v.slot] = std::ffi::CString::new(value.as_str()).unwrap_or_default();
             }
         }
         let d = derive(&values, &loaded.tyre)?;
@@ -651,15 +652,6 @@ impl Instance {
         log: Logger,
         resource_location: Option<&str>,
     ) -> Result<Box<Instance>, (Logger, String)> {
-        Instance::new_variant(log, resource_location, None)
-    }
-
-    /// [`Instance::new`] for a start-value variant of the interface.
-    pub fn new_variant(
-        log: Logger,
-        resource_location: Option<&str>,
-        variant: Option<StartVariant>,
-    ) -> Result<Box<Instance>, (Logger, String)> {
         let Some(loc) = resource_location else {
             return Err((
                 log,
@@ -683,7 +675,13 @@ impl Instance {
             Ok(t) => t,
             Err(e) => return Err((log, e)),
         };
-        let sim = match Sim::initial(default_tyre.clone(), variant) {
+        // The packaged XML beside resources/ holds the chosen start values
+        // (e.g. force_model = brush); none there = the built-in XML's.
+        let chosen = match super::start::read_chosen(&resources) {
+            Ok(c) => c,
+            Err(e) => return Err((log, e)),
+        };
+        let sim = match Sim::initial(default_tyre.clone(), &chosen) {
             Ok(s) => s,
             Err(e) => return Err((log, e)),
         };
@@ -693,7 +691,7 @@ impl Instance {
             resources,
             default_tyre,
             sim,
-            variant,
+            chosen,
             states: Vec::new(),
         });
         for w in &inst.default_tyre.tyre.params().warnings {
@@ -715,7 +713,7 @@ impl Instance {
 
     /// fmi2Reset: back to the state right after fmi2Instantiate.
     pub fn reset(&mut self) -> Result<(), String> {
-        self.sim = Sim::initial(self.default_tyre.clone(), self.variant)?;
+        self.sim = Sim::initial(self.default_tyre.clone(), &self.chosen)?;
         self.event("reset to the instantiated state");
         Ok(())
     }

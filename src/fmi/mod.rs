@@ -4,8 +4,11 @@
 //! `modelDescription/modelDescription.xml` by build.rs), [`logging`] (the
 //! master's logger callback), [`resources`] (`fmuResourceLocation` URIs),
 //! [`instance`] (one FMU instance: state machine, parameters, the step),
-//! [`snapshot`] (FMU states and their byte format) and `exports` (the 34
-//! `extern "C"` functions, each a thin guarded wrapper).
+//! [`snapshot`] (FMU states and their byte format), [`start`] (the
+//! tyre-dependent start values: free rolling at FNOMIN) and `exports` (the 34
+//! `extern "C"` functions, each a thin guarded wrapper). The packaging and the
+//! small importer of `demo`/`bench` (`master.rs`) belong to the binary
+//! (`src/main.rs` mounts them under its own `crate::fmi`).
 //!
 //! The step itself is [`crate::transient::TransientModel::step`]: this layer never
 //! computes slips or forces, it only moves numbers across the boundary, checks
@@ -18,15 +21,12 @@
 pub mod exports;
 pub mod instance;
 pub mod logging;
-pub mod master;
 pub mod resources;
 pub mod snapshot;
 pub mod spec;
+pub mod start;
 pub mod types;
 pub mod vars;
 
 pub use instance::Instance;
 pub use vars::{GUID, MODEL_DESCRIPTION_XML, MODEL_IDENTIFIER};
-
-#[path = "../../packaging/mod.rs"]
-pub mod packaging;

@@ -1,5 +1,5 @@
-//! The old benchmark stand-in (kept for the fitter tests that use it as a
-//! cheap, independent model): a pure-lateral Magic-Formula-shaped fit of 18
+//! The old benchmark stand-in, now test support only (the fitter tests use it
+//! as a cheap, independent model; included by `#[path]`): a pure-lateral Magic-Formula-shaped fit of 18
 //! parameters to 100 000 synthetic samples, by this crate's fitter and by
 //! SciPy `least_squares` over NumPy (`python/bench_fit.py`) on the SAME model,
 //! data, start and bounds; wall time and final cost of both, and the ratio.
@@ -22,10 +22,10 @@
 //!
 //! Must never: assert on timings, or be mistaken for the real MF.
 
-use crate::fit::problem::par_rows;
-use crate::fit::{Param, Problem};
 use nalgebra::DMatrixViewMut;
 use rand::{Rng, SeedableRng};
+use tyrekit::fit::problem::par_rows;
+use tyrekit::fit::{Param, Problem};
 
 /// Parameter names of the stand-in, in θ order.
 pub const NAMES: [&str; 18] = [

@@ -3,7 +3,6 @@
 //! (|Fx| < 2 % of Fz with untouched start values, the bound), and its
 //! workflow part must write report.html and name the concealed effect.
 
-use std::path::PathBuf;
 use std::process::Command;
 
 /// The number after `key` in `line` (`key` followed by the value and a space).

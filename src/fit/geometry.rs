@@ -15,7 +15,8 @@
 //! fixed BREFF, so it is fitted by linear least squares over a grid of BREFF
 //! (non-negative DREFF, FREFF: Re falls with load); the loaded radius by
 //! linear least squares in (Q_FZ1, Q_FZ2). Only free-rolling samples are
-//! used (|α| < 1°, |SR| < 0.3 % where recorded, else |Fx| < 5 % Fz): under drive
+//! used (|α| < 1°, |SR| < 0.3 % where recorded, else |Fx| < 5 % Fz or a
+//! pure lateral sweep, where no torque drives the wheel): under drive
 //! or brake torque V/Ω follows the slip, not the radius.
 //!
 //! What the data cannot determine (WIDTH, ASPECT_RATIO, RIM_RADIUS,
@@ -28,7 +29,7 @@
 //! non-positive stiffness or Q_FZ2 ≤ 0 (MF 6.1's loaded radius divides by
 //! it), or claim a key the data did not determine.
 
-use crate::data::{Recording, Sample};
+use crate::data::{Recording, Sample, SegmentKind};
 use crate::tir::TyreParams;
 
 /// Keys no tyre recording determines.
@@ -120,7 +121,8 @@ struct Free {
 const SR_FREE: f64 = 0.003;
 
 /// Free-rolling samples: by the recorded SR where it yields enough of them
-/// (a real export's SR may carry an offset), else by |Fx| < 5 % Fz.
+/// (a real export's SR may carry an offset), else by |Fx| < 5 % Fz or by
+/// belonging to a pure lateral sweep (no drive or brake torque).
 fn free_samples(recs: &[Recording], p0: f64) -> Vec<Free> {
     let by_sr = free_samples_by(recs, true, p0);
     if by_sr.len() >= MIN_FREE {
@@ -138,6 +140,20 @@ fn free_samples_by(recs: &[Recording], use_sr: bool, p0: f64) -> Vec<Free> {
         let re = r.extra("Re");
         let rl = r.extra("Rl");
         let sr = r.extra("SR").filter(|_| use_sr);
+        // Samples of pure lateral sweeps: no drive or brake torque acts, so
+        // the wheel rolls freely whatever Fx the rolling resistance and the
+        // slip angle's drag give (a tyre with 10 % rolling resistance never
+        // meets |Fx| < 5 % Fz, and a lateral-only programme would have no
+        // free-rolling sample at all).
+        let mut lateral = vec![false; r.samples.len()];
+        for seg in r
+            .segments
+            .iter()
+            .filter(|g| g.kind == SegmentKind::PureLateral)
+        {
+            let end = seg.end.min(lateral.len());
+            lateral[seg.start.min(end)..end].fill(true);
+        }
         for (i, s) in r.samples.iter().enumerate() {
             let Sample {
                 fz,
@@ -151,7 +167,7 @@ fn free_samples_by(recs: &[Recording], use_sr: bool, p0: f64) -> Vec<Free> {
             // may carry offsets and rolling resistance); else |Fx| < 5 % Fz.
             let (fx_ok, sr_ok) = match sr.map(|v| v[i]).filter(|x| x.is_finite()) {
                 Some(x) => (!fx.is_finite() || fx.abs() < 0.15 * fz, x.abs() < SR_FREE),
-                None => (!fx.is_finite() || fx.abs() < 0.05 * fz, true),
+                None => (lateral[i] || !fx.is_finite() || fx.abs() < 0.05 * fz, true),
             };
             if !(fz > 0.1 * fmax && alpha.abs() < lim && fx_ok && sr_ok) {
                 continue;

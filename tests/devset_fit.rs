@@ -172,11 +172,19 @@ fn print_table(v: &[Outcome]) {
 
 /// Median ratio to the answer's baseline per group: the level the fit has
 /// reached must not get worse (a regression guard while the issue's figures
-/// are not all met; the strict test above is the goal).
-const MEDIAN_MAX: [(&str, f64); 2] = [("pure", 1.10), ("all", 2.30)];
+/// are not all met; the strict test below is the goal). Complete run of
+/// 2026-11-25 16:05 UTC: pure median 1.04 (16 of 60 over 1.15×), all rows
+/// 1.12 (13 of 60 over 1.5×); the bounds leave room for another machine's
+/// rounding in the multi-start picks, not for a lost stage.
+const MEDIAN_MAX: [(&str, f64); 2] = [("pure", 1.10), ("all", 1.30)];
+
+/// No single figure far off: the same run's worst was 3.64× (r12 all-row
+/// Fx, the combined weights extrapolated to a held-out slip angle). A lost
+/// geometry once gave 19.6× (r03: the built-in radius kept, κ ≈ 0.5 in the
+/// velocity-input replay) with the medians still inside their bounds.
+const ANY_MAX: f64 = 4.0;
 
 #[test]
-#[ignore = "regressed: the complete run of 2026-11-25 (before the combined-stage gate) measured pure median 1.21 > 1.10, all rows 1.73; the gate and the data-driven starts were measured on r04/r07 only"]
 fn devset_fit_does_not_get_worse() {
     let Some(v) = outcomes() else { return };
     for (g, max) in MEDIAN_MAX {
@@ -189,6 +197,18 @@ fn devset_fit_does_not_get_worse() {
         r.sort_by(|a, b| a.total_cmp(b));
         let med = r[r.len() / 2];
         assert!(med <= max, "{g}: median ratio {med:.2} > {max:.2}");
+    }
+    for o in v {
+        for f in o.figures.iter().filter(|f| !exempt(o, f)) {
+            assert!(
+                f.ratio() <= ANY_MAX,
+                "{} {} {}: {:.2}× the answer's baseline (> {ANY_MAX})",
+                o.answer.name,
+                f.group,
+                f.channel,
+                f.ratio()
+            );
+        }
     }
 }
 
@@ -221,7 +241,7 @@ fn devset_rows_match_the_answer_file() {
 
 /// Issue #14's acceptance figures on all 21 recordings.
 #[test]
-#[ignore = "not met yet: pure Fy/Mz of r02, r04, r05, r07, r08, r09, r11, r12, r14, r15, r16 and most all-row figures of the full/speed/short programmes (see the printed table; κ = ΩRe/(V cos α) of the data module vs the set's SR is one cause)"]
+#[ignore = "not met yet (run of 2026-11-25 16:05 UTC): pure Fx of 13 recordings (1.16-1.59x), r14 pure Fy 1.77x, r03 pure Mz 1.45x, r17 pure Mz 1.18x; all-row Fx of the full/speed programmes (1.67-3.64x)"]
 fn devset_fit_meets_the_issue_figures() {
     let Some(v) = outcomes() else { return };
     let mut fails = Vec::new();

@@ -36,9 +36,11 @@ use tyrekit::transient::TransientKind;
 const NAMED_MIN: usize = 17;
 const CONTROLS_MIN: usize = 3;
 const GAP_MEDIAN_MIN: f64 = 0.5;
-/// Before this work (issue #15's text): 5 of 18 named, 2 of 3 controls.
-const NAMED_BEFORE: usize = 5;
-const CONTROLS_BEFORE: usize = 2;
+/// The level measured on 25 Nov 2026 (main da15fc1, README's dev-set
+/// table): 8 of 18 named (issue #15's text: 5), 3 of 3 controls `none`
+/// (issue: 2). A regression guard, not the goal.
+const NAMED_BEFORE: usize = 8;
+const CONTROLS_BEFORE: usize = 3;
 
 struct Outcome {
     name: String,
@@ -245,12 +247,18 @@ fn print_table(v: &[Outcome]) {
     );
 }
 
-/// Live: no regression from the state the issue reports (5/18 named, 2/3
-/// controls `none`).
+/// Live: no regression from the last measured level (8/18 named, 3/3
+/// controls `none`). A partial run (`TYREKIT_DEVSET_ONLY`) checks only that
+/// every control in it stays `none`: the count covers the whole set.
 #[test]
 fn devset_diagnosis_does_not_regress() {
     let Some(v) = outcomes() else { return };
-    let (n, _, c, _, _) = summary(v);
+    let (n, ne, c, nc, _) = summary(v);
+    if ne + nc < 21 {
+        eprintln!("NOTE partial run ({} recordings): the named-count guard needs all 21", ne + nc);
+        assert_eq!(c, nc, "a control was given a physical name");
+        return;
+    }
     assert!(n >= NAMED_BEFORE, "named first {n}, before {NAMED_BEFORE}");
     assert!(
         c >= CONTROLS_BEFORE,

@@ -17,8 +17,9 @@
 //!   steady [`crate::mf::Tyre::evaluate`] does not apply LMUV (MFeval 4.0
 //!   does not either, and no reference file sets it); the step does.
 //! * **sliding-speed friction of general monotone shape**
-//!   (`[SPEED_FRICTION]`, keys `DMU` –, `VC` m/s, `MU0` –):
-//!   s = (1 + MU0)·(1 − DMU·x/(1 + x)), x = Vs/VC — a friction that changes monotonically with the sliding
+//!   (`[SPEED_FRICTION]`, keys `DMU` –, `VC` m/s, `MU0` –, `VREF` m/s):
+//!   s = (1 + MU0)·g(Vs)/g(σ·VREF), g(v) = 1 − DMU·x/(1 + x), x = v/VC,
+//!   σ = √(κ² + tan²α) the slip magnitude — a friction that changes monotonically with the sliding
 //!   speed and levels off at 1 − DMU: the shape of the Stribeck-type
 //!   friction laws, μ(v) = μk + (μs − μk)·g(v/vs) with g falling from 1
 //!   to 0 (the LuGre model's g, Canudas de Wit et al., *IEEE Trans. Autom.
@@ -29,6 +30,14 @@
 //!   (default 0) is the friction level at zero sliding speed relative to
 //!   the file's: a Magic Formula fitted to data that carry the speed law
 //!   already holds its average, so the law must be free to turn about it.
+//!   VREF (default 0) is the belt speed at which the file's Magic Formula
+//!   already holds the law: a Magic Formula fitted at belt speed V holds
+//!   g(σ·V) at every slip σ (its peak, curvature and fall after the peak
+//!   have absorbed it), so the same tyre at another belt speed V' sees the
+//!   ratio g(σ·V')/g(σ·V). VREF = 0 is the file's friction as the one at
+//!   zero sliding speed (a Magic Formula measured without the effect, or
+//!   the law written over a static friction); at Vx = VREF the scale is
+//!   1 + MU0 at every slip.
 //! * **tread temperature** (`[THERMAL]`, keys `CAPACITY` J/K, `COOLING` W/K,
 //!   `SHARE` –, `MU_T0`, `MU_T1`, `MU_T2` –; temperatures relative to the
 //!   ambient air): a lumped heat balance C·dT/dt = q·P − h·(T − Tamb) with
@@ -68,9 +77,10 @@ pub const LOAD_KEYS: [&str; 3] = ["MU_DFZ1", "MU_DFZ2", "K_DFZ1"];
 /// Section of the sliding-speed friction of general shape.
 pub const SPEED_SECTION: &str = "SPEED_FRICTION";
 /// Keys of [`SPEED_SECTION`]: the friction change at high sliding speed
-/// (DMU, –), the sliding speed of half of it (VC, m/s) and the level at
-/// zero sliding speed (MU0, –, optional, 0).
-pub const SPEED_KEYS: [&str; 3] = ["DMU", "VC", "MU0"];
+/// (DMU, –), the sliding speed of half of it (VC, m/s), the level at
+/// zero sliding speed (MU0, –, optional, 0) and the belt speed at which
+/// the file's Magic Formula holds the law (VREF, m/s, optional, 0).
+pub const SPEED_KEYS: [&str; 4] = ["DMU", "VC", "MU0", "VREF"];
 /// Section of the tread-temperature model.
 pub const THERMAL_SECTION: &str = "THERMAL";
 /// Keys of [`THERMAL_SECTION`].
@@ -145,6 +155,29 @@ pub fn speed_friction(dmu: f64, vc: f64, vs: f64) -> f64 {
     1.0 - dmu * x / (1.0 + x)
 }
 
+/// The sliding-speed friction law of [`SPEED_SECTION`] (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpeedLaw {
+    /// Friction change at high sliding speed (–, < 1).
+    pub dmu: f64,
+    /// Sliding speed of half the change (m/s, > 0).
+    pub vc: f64,
+    /// Level at zero sliding speed relative to the file's (–, > −1).
+    pub mu0: f64,
+    /// Belt speed at which the file's Magic Formula holds the law (m/s, ≥ 0).
+    pub vref: f64,
+}
+
+impl SpeedLaw {
+    /// Friction scale at forward speed `vx_abs` (m/s) and slip magnitude
+    /// `slip` = √(κ² + tan²α): (1 + MU0)·g(Vs)/g(slip·VREF), Vs = vx_abs·slip.
+    #[inline]
+    pub fn scale(&self, vx_abs: f64, slip: f64) -> f64 {
+        let g = |v: f64| speed_friction(self.dmu, self.vc, v);
+        (1.0 + self.mu0) * g(vx_abs * slip) / g(self.vref * slip)
+    }
+}
+
 /// The extension physics of one tyre (None fields: not in the file).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct Extension {
@@ -152,8 +185,8 @@ pub struct Extension {
     pub load: Option<[f64; 3]>,
     /// LMUV and V0 (LONGVL, m/s).
     pub lmuv: Option<(f64, f64)>,
-    /// (DMU, VC m/s, MU0) of [`SPEED_SECTION`].
-    pub speed: Option<(f64, f64, f64)>,
+    /// The law of [`SPEED_SECTION`].
+    pub speed: Option<SpeedLaw>,
     pub thermal: Option<Thermal>,
     /// Nominal load Fz0 = FNOMIN·LFZO (N).
     pub fz0: f64,
@@ -221,6 +254,10 @@ impl Extension {
         let dmu = number(t, SPEED_SECTION, SPEED_KEYS[0])?;
         let vc = number(t, SPEED_SECTION, SPEED_KEYS[1])?;
         let mu0 = number(t, SPEED_SECTION, SPEED_KEYS[2])?.unwrap_or(0.0);
+        let vref = number(t, SPEED_SECTION, SPEED_KEYS[3])?.unwrap_or(0.0);
+        if !(vref >= 0.0) {
+            return Err(bad("VREF", "[SPEED_FRICTION] VREF must be >= 0 (m/s, the belt speed at which the file's friction holds; 0: the file's friction is the one at zero sliding speed)"));
+        }
         if !(mu0 > -1.0) {
             return Err(bad("MU0", "[SPEED_FRICTION] MU0 must be above -1 (the friction level 1 + MU0 must stay positive)"));
         }
@@ -232,7 +269,14 @@ impl Extension {
                 ));
             }
             match vc {
-                Some(v) if v > 0.0 => e.speed = Some((d, v, mu0)),
+                Some(vc) if vc > 0.0 => {
+                    e.speed = Some(SpeedLaw {
+                        dmu: d,
+                        vc,
+                        mu0,
+                        vref,
+                    })
+                }
                 _ => {
                     return Err(bad(
                         "VC",
@@ -286,9 +330,9 @@ impl Extension {
         if let Some((lmuv, _)) = self.lmuv {
             t.p.lmuv = lmuv;
         }
-        if let Some((d, v, m)) = self.speed {
+        if let Some(l) = self.speed {
             let s = t.extra_section(SPEED_SECTION);
-            for (k, x) in SPEED_KEYS.iter().zip([d, v, m]) {
+            for (k, x) in SPEED_KEYS.iter().zip([l.dmu, l.vc, l.mu0, l.vref]) {
                 s.set(k, x);
             }
         }
@@ -312,12 +356,12 @@ impl Extension {
             c *= 1.0 + k1 * dfz;
         }
         if self.lmuv.is_some() || self.speed.is_some() {
-            let vs = kin.vx_abs * (kin.kappa * kin.kappa + kin.tan_alpha * kin.tan_alpha).sqrt();
+            let slip = (kin.kappa * kin.kappa + kin.tan_alpha * kin.tan_alpha).sqrt();
             if let Some((lmuv, v0)) = self.lmuv {
-                s /= 1.0 + lmuv * vs / v0;
+                s /= 1.0 + lmuv * kin.vx_abs * slip / v0;
             }
-            if let Some((dmu, vc, mu0)) = self.speed {
-                s *= (1.0 + mu0) * speed_friction(dmu, vc, vs);
+            if let Some(l) = self.speed {
+                s *= l.scale(kin.vx_abs, slip);
             }
         }
         if let Some(m) = self.thermal {
@@ -440,14 +484,36 @@ mod tests {
         }
         let t = with("[SPEED_FRICTION]\nDMU = 0.12\nVC = 1.5\nMU0 = 0.03\n");
         let e = Extension::from_params(&t).unwrap().unwrap();
-        assert_eq!(e.speed, Some((0.12, 1.5, 0.03)));
+        let law = SpeedLaw {
+            dmu: 0.12,
+            vc: 1.5,
+            mu0: 0.03,
+            vref: 0.0,
+        };
+        assert_eq!(e.speed, Some(law));
+        // VREF = 0: the law over the file's friction at zero sliding speed.
+        assert!((law.scale(10.0, 0.1) - 1.03 * speed_friction(0.12, 1.5, 1.0)).abs() < 1e-15);
+        let t = with("[SPEED_FRICTION]\nDMU = 0.12\nVC = 1.5\nVREF = 11.1\n");
+        let e = Extension::from_params(&t).unwrap().unwrap();
+        let law = e.speed.unwrap();
+        assert_eq!(law.vref, 11.1);
+        // At the reference belt speed the file's friction holds at every
+        // slip (to rounding); below it the friction is higher, above it
+        // lower.
+        for slip in [0.0, 0.02, 0.1, 0.3] {
+            assert!((law.scale(11.1, slip) - 1.0).abs() < 1e-12);
+        }
+        let (lo, hi) = (law.scale(8.9, 0.1), law.scale(13.3, 0.1));
+        assert!(lo > 1.0 && hi < 1.0, "{lo} {hi}");
         let mut w = with("");
         e.write_to(&mut w);
         let back = TyreParams::from_tir_str(&w.to_tir_string(), "w.tir").unwrap();
         assert_eq!(
             Extension::from_params(&back).unwrap().unwrap().speed,
-            Some((0.12, 1.5, 0.03))
+            Some(law)
         );
+        let bad = Extension::from_params(&with("[SPEED_FRICTION]\nDMU = 0.1\nVC = 1\nVREF = -3\n"));
+        assert!(bad.unwrap_err().to_string().contains("VREF"));
         let bad = Extension::from_params(&with("[SPEED_FRICTION]\nDMU = 1.2\nVC = 1\n"));
         assert!(bad.unwrap_err().to_string().contains("DMU"));
         let bad = Extension::from_params(&with("[SPEED_FRICTION]\nDMU = 0.1\n"));

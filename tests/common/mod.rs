@@ -221,3 +221,39 @@ pub fn fit_sine(t: &[f64], y: &[f64], w: f64) -> (f64, f64) {
         .expect("regular normal equations");
     (x[0].hypot(x[1]), x[1].atan2(x[0]))
 }
+
+/// A rig run's noise-free ISO-W samples and segments as a recording, with
+/// white sensor noise of 12 N on Fx and Fy and 0.4 N·m on Mz (the rig's
+/// default levels) from a fixed seed.
+pub fn noisy_rig_recording(
+    source: &str,
+    mut samples: Vec<tyrekit::data::Sample>,
+    segments: Vec<tyrekit::data::Segment>,
+    seed: u64,
+) -> tyrekit::data::Recording {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut g = || {
+        let u1: f64 = rng.gen::<f64>().max(1e-300);
+        let u2: f64 = rng.gen();
+        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+    };
+    for s in &mut samples {
+        s.fx += 12.0 * g();
+        s.fy += 12.0 * g();
+        s.mz += 0.4 * g();
+    }
+    let (sweep_dir, t_in_segment) = tyrekit::data::structure::sweep_and_time(&samples, &segments);
+    tyrekit::data::Recording {
+        source: source.into(),
+        samples,
+        channels: tyrekit::data::SAMPLE_CHANNELS
+            .iter()
+            .map(|c| c.to_string())
+            .collect(),
+        extra: vec![],
+        segments,
+        sweep_dir,
+        t_in_segment,
+    }
+}

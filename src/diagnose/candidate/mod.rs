@@ -14,7 +14,7 @@
 //! | `thermal` | `[THERMAL]` CAPACITY (time constant with COOLING = 40 W/K, SHARE = 0.5), MU_T0..2 | LM, replayed (tread-temperature state) |
 //! | `load_sensitivity` | `[LOAD_SENSITIVITY]` MU_DFZ1, MU_DFZ2, K_DFZ1 | LM on a subsample (static) |
 //! | `pressure` | PPX1, PPX3, PPX4 (with Fx data), PPY1, PPY3, PPY4 (with Fy/Mz data) (MF 6.x only: MF 5.2/PAC2002 have no pressure terms; needs two pressures) | LM, static |
-//! | `speed_friction` | `[SPEED_FRICTION]` DMU, VC, MU0 (s = (1 + MU0)·(1 − DMU·x/(1 + x)), x = Vs/VC) | LM, static |
+//! | `speed_friction` | `[SPEED_FRICTION]` DMU, VC, VREF (s = g(Vs)/g(σ·VREF), g(v) = 1 − DMU·x/(1 + x), x = v/VC) | LM from two starts, static |
 //! | `rolling_radius` | Q_RE0, FREFF (Re(Fz)); κ re-derived as (1+κ)·Re/Re_baseline − 1 | LM, static |
 //! | `camber` | PDY3, PKY6, PKY7 (PKY3, PHY3 for MF 5.2/PAC2002), PVY3, QHZ3, QDZ8, QDZ9 | LM, static |
 //!

@@ -191,12 +191,22 @@ pub struct Param {
     pub hi: f64,
     pub h: f64,
     pub channels: &'static [usize],
+    /// The lower bound is a physical value the parameter may take (VREF =
+    /// 0: the file's friction is the one at zero sliding speed), not a
+    /// limit of the range: a fit ending there is not reported at a bound.
+    pub natural_lo: bool,
 }
 
 impl Param {
     /// The same parameter acting on `channels` only.
     pub fn on(mut self, channels: &'static [usize]) -> Param {
         self.channels = channels;
+        self
+    }
+    /// The same parameter with a lower bound that is a value, not a limit
+    /// ([`Param::natural_lo`]).
+    pub fn natural_lo(mut self) -> Param {
+        self.natural_lo = true;
         self
     }
 }
@@ -225,6 +235,12 @@ pub struct Spec {
     /// — at one pressure the pressure terms can only fit sensor noise on the
     /// recorded pressure and end at a bound.
     pub levels: Option<(fn(&crate::data::Segment) -> f64, f64)>,
+    /// Further start points (parameter name, start value overriding
+    /// [`Param::init`]): LM runs from the plain start and from each of
+    /// these, and the fit with the lowest fit-half cost is kept — for a
+    /// parameter whose cost has two valleys LM cannot cross (VREF of the
+    /// speed law: at 0 or at the recorded belt speeds).
+    pub restarts: Vec<Vec<(&'static str, f64)>>,
 }
 
 /// Distinct levels of `levels` among the segments overlapping `mask`.
@@ -500,7 +516,24 @@ impl Candidate for ParamCandidate {
                 q.init *= f;
             }
         }
-        let theta = fit_lm(&params, resid);
+        let cost = |t: &[f64]| resid(t).map_or(f64::INFINITY, |r| r.iter().map(|x| x * x).sum());
+        let mut theta = fit_lm(&params, &resid);
+        if !spec.restarts.is_empty() {
+            let mut best = cost(&theta);
+            for over in &spec.restarts {
+                let mut q = params.clone();
+                for (name, v) in over {
+                    if let Some(x) = q.iter_mut().find(|x| x.name == *name) {
+                        x.init = *v;
+                    }
+                }
+                let t = fit_lm(&q, &resid);
+                let c = cost(&t);
+                if c < best {
+                    (theta, best) = (t, c);
+                }
+            }
+        }
         let mut m = model_of(&theta)?;
         m.params = params
             .iter()
@@ -513,7 +546,7 @@ impl Candidate for ParamCandidate {
             .filter_map(|(q, &v)| {
                 // Within 0.1 % of the range of a bound (LM clamps onto it).
                 let tol = 1e-3 * (q.hi - q.lo).abs();
-                let which = if (v - q.lo).abs() <= tol {
+                let which = if (v - q.lo).abs() <= tol && !q.natural_lo {
                     "lower"
                 } else if (q.hi - v).abs() <= tol {
                     "upper"
@@ -547,6 +580,7 @@ pub(super) fn p(
         hi,
         h,
         channels: ALL_CHANNELS,
+        natural_lo: false,
     }
 }
 

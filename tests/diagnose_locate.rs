@@ -96,6 +96,7 @@ fn run(s: &Synth, r: &[f64], perms: usize) -> Vec<Finding> {
         t_in_segment: &s.t,
         energy: &s.energy,
         segments: &s.segments,
+        samples: &[],
     };
     locate(
         &d,
@@ -196,4 +197,70 @@ fn planted_time_drift_is_found_first() {
     let t = top(&f);
     assert_eq!(t.name, "time_in_run");
     assert!(t.significant);
+}
+
+/// A pressure that drifts continuously (a saw-tooth of ±4 % about one set
+/// point, rising over 60 % of the test then let down) with the force scale
+/// following it (+3 % at the top, −3 % at the bottom), and segments whose
+/// binned speed set points alternate 11.1 / 11.2 m/s while the recorded
+/// speed is one belt speed with 0.05 m/s noise: the pressure dependence is
+/// found on the recorded (continuous) pressure, and the two speed "levels",
+/// closer than 10× the speed's noise, are not tested at all.
+#[test]
+fn continuous_pressure_is_found_and_speed_levels_within_noise_are_not() {
+    use tyrekit::data::Sample;
+    let mut s = synth();
+    let n = s.sim.len();
+    let mut rng = ChaCha8Rng::seed_from_u64(10);
+    let mut g = || {
+        let u1: f64 = rng.gen::<f64>().max(1e-300);
+        let u2: f64 = rng.gen();
+        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+    };
+    let dp = |i: usize| 0.04 * (2.0 * (i as f64 / (0.6 * n as f64)).fract() - 1.0);
+    let samples: Vec<Sample> = (0..n)
+        .map(|i| Sample {
+            time: i as f64 * 0.02,
+            p: 2e5 * (1.0 + dp(i)) + 100.0 * g(),
+            vx: 11.11 + 0.05 * g(),
+            fz: s.fz[i],
+            ..Default::default()
+        })
+        .collect();
+    for (k, seg) in s.segments.iter_mut().enumerate() {
+        seg.vx = if k % 2 == 0 { 11.1 } else { 11.2 };
+    }
+    let mut r = noise(n, 20.0, 0.9, 11);
+    for (i, x) in r.iter_mut().enumerate() {
+        *x += 0.75 * dp(i) * s.sim[i];
+    }
+    let d = Residuals {
+        r: &r,
+        sim: &s.sim,
+        slip: &s.slip,
+        sweep_dir: &s.dir,
+        t_in_segment: &s.t,
+        energy: &s.energy,
+        segments: &s.segments,
+        samples: &samples,
+    };
+    let f = locate(
+        &d,
+        &LocateOptions {
+            permutations: 499,
+            ..Default::default()
+        },
+    );
+    let t = top(&f);
+    assert_eq!(t.name, "pressure");
+    assert!(t.significant);
+    // The segment means of the recorded pressure, not the one set point:
+    // the lowest and highest lie near the saw-tooth's ends (±4 % ∓ the
+    // averaging over one segment).
+    assert!(
+        t.group("x_min") < 1.97e5 && t.group("x_max") > 2.03e5,
+        "{}",
+        t.detail
+    );
+    assert!(f.iter().all(|x| x.name != "speed"), "speed tested");
 }

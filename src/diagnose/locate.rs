@@ -12,6 +12,14 @@
 //!   r²(x, b) + r²(x, m) against the segment's set point `x` (for `energy`:
 //!   the accumulated frictional energy at the segment's middle). Null: the
 //!   segment values exchanged among segments (permutation test).
+//!   `pressure` takes each segment's mean *recorded* pressure, not its
+//!   binned set point, so that a drifting, leaking or saw-tooth pressure is
+//!   a continuous factor (the scale errors reported are then those of the
+//!   least-squares line over the segments, at its lowest and highest
+//!   pressure, not two single noisy segments). A factor whose values span
+//!   no more than [`factor::MIN_SPAN_NOISE`] times its recorded noise
+//!   ([`factor::noise`]) is not tested: two binned "levels" of one belt
+//!   speed are not a dependence on speed.
 //!
 //! Sample level (within segments; residuals demeaned per segment; at most
 //! [`MAX_WITHIN`] samples, longer recordings thinned by a constant stride):
@@ -41,7 +49,8 @@
 //! Must never: call a grouping significant without its null distribution,
 //! or use an unseeded random source.
 
-use crate::data::{Recording, Segment};
+use super::factor;
+use crate::data::{Recording, Sample, Segment};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -62,6 +71,10 @@ pub struct Residuals<'a> {
     pub energy: &'a [f64],
     /// The test segments (with their set points).
     pub segments: &'a [Segment],
+    /// The recording's samples, for the recorded conditions (pressure,
+    /// speed, load, inclination) and their noise; empty: set points only,
+    /// no noise rule.
+    pub samples: &'a [Sample],
 }
 
 /// Settings.
@@ -411,17 +424,40 @@ pub fn locate(d: &Residuals, o: &LocateOptions) -> Vec<Finding> {
         let i = ((g.start + g.end) / 2).min(d.energy.len().saturating_sub(1));
         d.energy.get(i).copied().unwrap_or(f64::NAN)
     };
-    type Cov<'c> = (&'static str, &'c dyn Fn(&Segment) -> f64);
+    // (name, value per segment, the recorded condition per sample (None:
+    // no sample-level reading), continuous: fitted line instead of the
+    // extreme segments).
+    type Cov<'c> = (
+        &'static str,
+        &'c dyn Fn(&Segment) -> f64,
+        Option<fn(&Sample) -> f64>,
+        bool,
+    );
+    let have_samples = !d.samples.is_empty();
+    let mean_p = |g: &Segment| {
+        let m = factor::segment_mean(d.samples, g, |s| s.p);
+        if m.is_finite() {
+            m
+        } else {
+            g.p
+        }
+    };
     let covs: [Cov; 5] = [
-        ("load", &|g| g.fz),
-        ("inclination", &|g| g.gamma),
-        ("pressure", &|g| g.p),
-        ("speed", &|g| g.vx),
-        ("energy", &mid_energy),
+        ("load", &|g| g.fz, Some(|s| s.fz), false),
+        ("inclination", &|g| g.gamma, Some(|s| s.gamma), false),
+        (
+            "pressure",
+            if have_samples { &mean_p } else { &|g| g.p },
+            Some(|s| s.p),
+            have_samples,
+        ),
+        ("speed", &|g| g.vx, Some(|s| s.vx), false),
+        ("energy", &mid_energy, None, false),
     ];
     let m: Vec<f64> = sv.iter().map(|v| v.1).collect();
     let b: Vec<f64> = sv.iter().map(|v| v.2).collect();
-    for (name, f) in covs {
+    let used: Vec<&Segment> = sv.iter().map(|v| &d.segments[v.0]).collect();
+    for (name, f, get, continuous) in covs {
         let x: Vec<f64> = sv.iter().map(|v| f(&d.segments[v.0])).collect();
         if x.iter().any(|v| !v.is_finite()) {
             continue;
@@ -431,6 +467,12 @@ pub fn locate(d: &Residuals, o: &LocateOptions) -> Vec<Finding> {
         let scale = x.iter().map(|v| v.abs()).fold(0.0, f64::max);
         if x.len() < 4 || spread.partial_cmp(&(1e-9 * scale)) != Some(std::cmp::Ordering::Greater) {
             continue;
+        }
+        // Levels closer than the condition's own noise are not a factor.
+        if let (true, Some(get)) = (have_samples, get) {
+            if !factor::varies_beyond_noise(spread, factor::noise(d.samples, &used, get)) {
+                continue;
+            }
         }
         let stat = |perm: &[usize]| {
             let pm: Vec<f64> = perm.iter().map(|&j| m[j]).collect();
@@ -448,7 +490,11 @@ pub fn locate(d: &Residuals, o: &LocateOptions) -> Vec<Finding> {
                 stat(&perm)
             })
             .collect();
-        let (lo, hi) = extremes(&x, &b);
+        let (lo, hi) = if continuous {
+            fitted_extremes(&x, &b)
+        } else {
+            extremes(&x, &b)
+        };
         out.push(
             Finding::new(
                 name,
@@ -575,6 +621,15 @@ pub fn locate(d: &Residuals, o: &LocateOptions) -> Vec<Finding> {
         })
     });
     out
+}
+
+/// (x, ŷ) at the smallest and largest x, ŷ on the least-squares line of y on x.
+fn fitted_extremes(x: &[f64], y: &[f64]) -> ((f64, f64), (f64, f64)) {
+    let k = slope(x, y);
+    let n = x.len().max(1) as f64;
+    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let ((a, _), (b, _)) = extremes(x, y);
+    ((a, my + k * (a - mx)), (b, my + k * (b - mx)))
 }
 
 /// (x, y) at the smallest and largest x.

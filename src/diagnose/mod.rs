@@ -12,6 +12,7 @@
 
 pub mod baseline;
 pub mod candidate;
+pub mod factor;
 pub mod html;
 pub mod locate;
 pub mod plots;

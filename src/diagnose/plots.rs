@@ -12,7 +12,10 @@
 //!   time in the run and per segment against the accumulated frictional
 //!   energy: a temperature or wear state drifts;
 //! * `overlay_CH.svg` — measured, baseline and extended model against slip on
-//!   the held-out segments the verdict changes most.
+//!   the held-out segments the verdict changes most;
+//! * `residual_pressure_CH.svg` (verdict `pressure` only) — per segment the
+//!   relative force scale error against the segment's mean recorded
+//!   pressure (kPa), baseline and extended: the verdict's own evidence.
 //!
 //! Must never: draw more than a few thousand points per series (strided),
 //! or fail on a channel the recording lacks (it is skipped).
@@ -218,6 +221,8 @@ impl Chan<'_> {
 /// Draw every picture of the diagnosis into `dir`.
 pub fn draw_all(rec: &Recording, d: &Diagnosis, dir: &Path) -> Result<Vec<Plot>> {
     let mut out = Vec::new();
+    // The verdict's own evidence, drawn first.
+    let mut evidence = Vec::new();
     for ch in Channel::SCORED {
         let (name, unit) = (ch.key(), ch.unit());
         if !channel_present(rec, ch) {
@@ -248,8 +253,12 @@ pub fn draw_all(rec: &Recording, d: &Diagnosis, dir: &Path) -> Result<Vec<Plot>>
         out.push(hysteresis(&c, &d.verdict, dir)?);
         out.push(drift(&c, &d.energy, &d.verdict, dir)?);
         out.push(overlay(&c, &d.verdict, dir)?);
+        if d.verdict == "pressure" {
+            evidence.push(residual_pressure(&c, &d.verdict, dir)?);
+        }
     }
-    Ok(out)
+    evidence.extend(out);
+    Ok(evidence)
 }
 
 fn after_label(verdict: &str) -> String {
@@ -360,13 +369,32 @@ fn scale_error(c: &Chan, k: usize, after: bool) -> f64 {
     }
 }
 
-fn residual_load(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
-    let file = format!("residual_load_{}.svg", c.name.to_lowercase());
+/// What a per-segment scale-error plot draws against.
+struct SegmentAxis {
+    /// File name stem (`residual_load`).
+    stem: &'static str,
+    /// The condition's name in the title ("load").
+    what: &'static str,
+    /// Axis label with unit.
+    label: &'static str,
+    /// The condition's value of a segment, in the axis' unit.
+    x: fn(&Recording, &crate::data::Segment) -> f64,
+    /// What to look for, after "Per segment, the CH residual as a share of
+    /// the model force (+ = measured stronger) against ".
+    look_for: &'static str,
+}
+
+/// Per segment the relative force scale error against a condition of the
+/// segment, baseline and extended.
+fn segment_scale_plot(c: &Chan, verdict: &str, dir: &Path, ax: &SegmentAxis) -> Result<Plot> {
+    let file = format!("{}_{}.svg", ax.stem, c.name.to_lowercase());
     let path = dir.join(&file);
-    let segs = 0..c.rec.segments.len();
     let pts = |after: bool| -> Vec<(f64, f64)> {
-        segs.clone()
-            .map(|k| (c.rec.segments[k].fz, 100.0 * scale_error(c, k, after)))
+        c.rec
+            .segments
+            .iter()
+            .enumerate()
+            .map(|(k, g)| ((ax.x)(c.rec, g), 100.0 * scale_error(c, k, after)))
             .filter(|p| p.0.is_finite() && p.1.is_finite())
             .collect()
     };
@@ -376,8 +404,12 @@ fn residual_load(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
         panel(
             &ar[0],
             &path,
-            &format!("{} force scale error per segment vs load", c.ch.name()),
-            "Fz [N]",
+            &format!(
+                "{} force scale error per segment vs {}",
+                c.ch.name(),
+                ax.what
+            ),
+            ax.label,
             "Σ r·F / Σ F² [%]",
             &[
                 Series::Points(b.clone(), BASE, "baseline".into(), 3),
@@ -390,10 +422,44 @@ fn residual_load(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
         file,
         channel: c.name,
         caption: format!(
-            "Per segment, the {} residual as a share of the model force (+ = measured stronger) against load: a trend with load is a load-sensitivity error, scatter between segments at one load a pressure, speed or temperature effect.",
-            c.ch.name()
+            "Per segment, the {} residual as a share of the model force (+ = measured stronger) against {}",
+            c.ch.name(),
+            ax.look_for
         ),
     })
+}
+
+fn residual_load(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
+    segment_scale_plot(
+        c,
+        verdict,
+        dir,
+        &SegmentAxis {
+            stem: "residual_load",
+            what: "load",
+            label: "Fz [N]",
+            x: |_, g| g.fz,
+            look_for: "load: a trend with load is a load-sensitivity error, scatter between segments at one load a pressure, speed or temperature effect.",
+        },
+    )
+}
+
+/// Per segment the relative force scale error against the segment's mean
+/// recorded pressure (kPa), baseline and extended (the evidence of a
+/// `pressure` verdict: a slope that the extended model flattens).
+fn residual_pressure(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
+    segment_scale_plot(
+        c,
+        verdict,
+        dir,
+        &SegmentAxis {
+            stem: "residual_pressure",
+            what: "pressure",
+            label: "recorded inflation pressure (segment mean) [kPa]",
+            x: |rec, g| super::factor::segment_mean(&rec.samples, g, |s| s.p) / 1e3,
+            look_for: "the recorded inflation pressure: a slope in the baseline is the pressure dependence the baseline lacks; the extended model should flatten it.",
+        },
+    )
 }
 
 /// Mean of y per x bin over `idx`, rising and falling sweeps apart.

@@ -87,6 +87,7 @@ pub fn locate_channel(
         t_in_segment: &rec.t_in_segment,
         energy,
         segments: &rec.segments,
+        samples: &rec.samples,
     };
     locate(&d, &LocateOptions::default())
 }
@@ -310,7 +311,7 @@ fn set_point(grouping: &str, x: f64) -> String {
     match grouping {
         "load" => format!("{x:.0} N"),
         "inclination" => format!("{:.1}°", x.to_degrees()),
-        "pressure" => format!("{:.0} kPa", x / 1e3),
+        "pressure" => format!("{:.1} kPa", x / 1e3),
         "speed" => format!("{x:.1} m/s"),
         "energy" => format!("{:.0} kJ", x / 1e3),
         _ => format!("{x:.4}"),

@@ -13,7 +13,7 @@
 //! | `lugre` | `[LUGRE]` SIGMA0X, SIGMA0Y (bristle stiffness), MUS (Stribeck ratio) | LM, replayed transient |
 //! | `thermal` | `[THERMAL]` CAPACITY (time constant with COOLING = 40 W/K, SHARE = 0.5), MU_T0..2 | LM, replayed (tread-temperature state) |
 //! | `load_sensitivity` | `[LOAD_SENSITIVITY]` MU_DFZ1, MU_DFZ2, K_DFZ1 | LM on a subsample (static) |
-//! | `pressure` | PPX1, PPX3, PPX4 (with Fx data), PPY1, PPY3, PPY4 (with Fy/Mz data) (MF 6.x only: MF 5.2/PAC2002 have no pressure terms; needs two pressures) | LM, static |
+//! | `pressure` | PPX1, PPX3 (with Fx data), PPY1, PPY3 (with Fy/Mz data), PPZ1 (with Mz data) (MF 6.x only: MF 5.2/PAC2002 have no pressure terms; needs a recorded pressure that varies beyond its noise, [`crate::diagnose::factor`]) | LM, static |
 //! | `speed_friction` | `[SPEED_FRICTION]` DMU, VC, VREF (s = g(Vs)/g(σ·VREF), g(v) = 1 − DMU·x/(1 + x), x = v/VC) | LM from two starts, static |
 //! | `rolling_radius` | Q_RE0, FREFF (Re(Fz)); κ re-derived as (1+κ)·Re/Re_baseline − 1 | LM, static |
 //! | `camber` | PDY3, PKY6, PKY7 (PKY3, PHY3 for MF 5.2/PAC2002), PVY3, QHZ3, QDZ8, QDZ9 | LM, static |
@@ -51,7 +51,7 @@
 //!   likelihood with one variance per channel, at the baseline). Only the
 //!   parameters acting on a channel with data are fitted ([`Param::channels`]:
 //!   PPX* need Fx), `pressure` and `camber` only when the fit half spans two
-//!   levels of pressure or inclination ([`Spec::levels`]); a fitted
+//!   levels of inclination ([`Spec::levels`]) or a recorded pressure that varies beyond its noise ([`Spec::varies`]); a fitted
 //!   parameter ending at a bound is reported ([`Fitted::at_bound`]).
 //! * Gains: per channel, the relative drop of its held-out (and fit-half)
 //!   SSE against the baseline's ([`ChannelScore`]); pooled, 1 − the

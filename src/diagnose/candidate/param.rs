@@ -241,6 +241,25 @@ pub struct Spec {
     /// parameter whose cost has two valleys LM cannot cross (VREF of the
     /// speed law: at 0 or at the recorded belt speeds).
     pub restarts: Vec<Vec<(&'static str, f64)>>,
+    /// A condition recorded per sample that the parameters act through,
+    /// continuous (a drifting or leaking pressure): the candidate is fitted
+    /// only when its values over the fit half span clearly more than their
+    /// noise ([`crate::diagnose::factor::varies_beyond_noise`]).
+    pub varies: Option<fn(&crate::data::Sample) -> f64>,
+}
+
+/// Whether `get` varies beyond its noise over the segments overlapping `mask`.
+fn varies(rec: &Recording, mask: &[bool], get: fn(&crate::data::Sample) -> f64) -> bool {
+    use crate::diagnose::factor;
+    let segs: Vec<&crate::data::Segment> = rec
+        .segments
+        .iter()
+        .filter(|g| mask.get(g.start).copied().unwrap_or(false))
+        .collect();
+    factor::varies_beyond_noise(
+        factor::span(&rec.samples, &segs, get),
+        factor::noise(&rec.samples, &segs, get),
+    )
 }
 
 /// Distinct levels of `levels` among the segments overlapping `mask`.
@@ -433,7 +452,8 @@ impl Candidate for ParamCandidate {
         let free: Vec<usize> = (0..spec.params.len())
             .filter(|&i| spec.params[i].channels.iter().any(|&c| w[c] > 0.0))
             .collect();
-        let one_level = spec.levels.is_some_and(|l| level_count(rec, mask, l) < 2);
+        let one_level = spec.levels.is_some_and(|l| level_count(rec, mask, l) < 2)
+            || spec.varies.is_some_and(|g| !varies(rec, mask, g));
         if free.is_empty() || one_level {
             return NoneCandidate.fit(rec, baseline, opts, mask, w);
         }

@@ -1,4 +1,21 @@
-//! pressure — the MF 6.x inflation-pressure terms of slip stiffness and friction (PPX*, PPY*).
+//! pressure — the inflation pressure changes slip stiffness, peak friction
+//! and the pneumatic trail, fitted on the pressure recorded per sample
+//! (discrete set points, a drift, a leak or a saw-tooth alike) with the
+//! MF 6.1 first-order pressure terms, written as the standard keys so that
+//! the FMU and `replay` apply them with the recorded `p`:
+//! * PPX1: Kxκ ∝ (1 + PPX1·dpi) (Pacejka, *Tyre and Vehicle Dynamics*,
+//!   3rd ed., eq. 4.E15), PPX3: μx ∝ (1 + PPX3·dpi) (eq. 4.E13, PPX4 = 0);
+//! * PPY1: Kyα ∝ (1 + PPY1·dpi) (eq. 4.E25, PPY2 held), PPY3: μy ∝
+//!   (1 + PPY3·dpi) (eq. 4.E23, PPY4 = 0);
+//! * PPZ1: the pneumatic trail Dt ∝ (1 − PPZ1·dpi) (eq. 4.E42);
+//!
+//! dpi = (p − p0)/p0, p0 = INFLPRES. The quadratic terms PPX4, PPY4 are not
+//! fitted: a drift of a few % of the pressure cannot tell a curvature from
+//! a slope (on r04 of the dev set they ended at their bounds), and the
+//! linear law is what a pressure set point ±15 % supports as well.
+//! Fitted only when the recorded pressure over the fit half spans clearly
+//! more than its noise ([`crate::diagnose::factor`]); at one regulated
+//! pressure the terms could only fit sensor noise.
 //!
 //! Must never: fit a parameter outside the range written here, or describe
 //! a value the fit did not produce.
@@ -8,53 +25,64 @@ use super::{FX, FY, MZ};
 use crate::mf::Tyre;
 use crate::residual::ReplayOptions;
 
+/// Range of every fitted pressure term (per unit dpi). The MF 6.1 files of
+/// `../shared/data/tir` carry first-order terms up to |4.9| (PPX1 of a
+/// racing tyre); ±5 admits them, and a value at ±5 — a 5 % change of
+/// stiffness or friction per 1 % of pressure — is reported as a limit.
+const RANGE: f64 = 5.0;
+
+/// The fitted terms: (key, channels it acts on).
+const TERMS: [(&str, &[usize]); 5] = [
+    ("PPX1", &[FX]),
+    ("PPX3", &[FX]),
+    ("PPY1", &[FY, MZ]),
+    ("PPY3", &[FY, MZ]),
+    ("PPZ1", &[MZ]),
+];
+
 fn pressure_spec(t: &Tyre, _: &ReplayOptions) -> Option<Spec> {
     if !is_mf6(t) {
         return None;
     }
-    let q = |k: &'static str| p(k, vec![key(k)], file(t, k), -3.0, 3.0, 0.005);
     Some(Spec {
-        params: vec![
-            q("PPX1").on(&[FX]),
-            q("PPX3").on(&[FX]),
-            q("PPX4").on(&[FX]),
-            q("PPY1").on(&[FY, MZ]),
-            q("PPY3").on(&[FY, MZ]),
-            q("PPY4").on(&[FY, MZ]),
-        ],
-        levels: Some((|g| g.p, 5e3)),
+        params: TERMS
+            .iter()
+            .map(|&(k, ch)| p(k, vec![key(k)], file(t, k), -RANGE, RANGE, 0.005).on(ch))
+            .collect(),
+        varies: Some(|s| s.p),
         ..Spec::default()
     })
+}
+
+/// The fitted law in words at ±`pct` % of the pressure.
+fn words(f: &dyn super::Fitted) -> String {
+    let pct = 10.0;
+    let mut parts = Vec::new();
+    let mut term = |k: &str, what: &str, sign: f64| {
+        let v = param(f, k);
+        if v.is_finite() {
+            parts.push(format!("{what} {:+.1} % ({k} = {v:.3})", sign * pct * v));
+        }
+    };
+    term("PPX1", "Fx slip stiffness", 1.0);
+    term("PPX3", "Fx peak friction", 1.0);
+    term("PPY1", "Fy cornering stiffness", 1.0);
+    term("PPY3", "Fy peak friction", 1.0);
+    // Dt ∝ (1 − PPZ1·dpi).
+    term("PPZ1", "pneumatic trail", -1.0);
+    if parts.is_empty() {
+        return "no pressure term fitted".into();
+    }
+    format!("at +{pct:.0} % inflation pressure: {}", parts.join(", "))
 }
 
 /// The candidate.
 pub(super) fn candidate() -> ParamCandidate {
     ParamCandidate {
         name: "pressure",
-        physics: "the inflation pressure changes slip stiffness and peak friction",
-        n: 6,
+        physics: "the inflation pressure changes slip stiffness, peak friction and pneumatic trail",
+        n: TERMS.len(),
         spec: pressure_spec,
-        words: |f| {
-            let mut parts = Vec::new();
-            for (a, b, c, what) in [
-                ("PPX1", "PPX3", "PPX4", "Fx"),
-                ("PPY1", "PPY3", "PPY4", "Fy"),
-            ] {
-                let (x, y, z) = (param(f, a), param(f, b), param(f, c));
-                if x.is_finite() && y.is_finite() && z.is_finite() {
-                    // Slip stiffness ∝ (1 + PP?1·dpi), friction ∝ (1 + PP?3·dpi)
-                    // (MF 6.1, Pacejka 3rd ed. eqs 4.E15/4.E25 and 4.E13/4.E23:
-                    // (1 + PP?1·dpi), (1 + PP?3·dpi + PP?4·dpi²),
-                    // dpi = (p − p0)/p0; PPX2, PPY2 held at 0).
-                    parts.push(format!(
-                        "{what} slip stiffness {:+.1} % and peak friction {:+.1} % at +10 % pressure, peak friction {:+.1} % at −10 % ({a} = {x:.3}, {b} = {y:.3}, {c} = {z:.3})",
-                        10.0 * x,
-                        10.0 * y + z,
-                        -10.0 * y + z
-                    ));
-                }
-            }
-            parts.join("; ")
-        },
+        words,
     }
 }

@@ -1,0 +1,167 @@
+//! factor — how far a recorded test condition (inflation pressure, speed,
+//! load, inclination) really varies, measured against its own noise: the
+//! rule that a dependence on a condition is only looked for (by [`super::locate`])
+//! or fitted (by the `pressure` candidate) when the condition spans clearly
+//! more than what its sensor noise alone would give. A pressure that drifts,
+//! leaks or saw-tooths by a few kPa is a continuous factor; a regulated
+//! pressure whose reading wanders by its noise is not, nor are two binned
+//! "levels" of one belt speed.
+//!
+//! Must never: call a condition varying when its span is within
+//! [`MIN_SPAN_NOISE`] times its noise, or read a sample outside the
+//! segments (or the mask) it is given.
+
+use crate::data::{Sample, Segment};
+
+/// Smallest span of a condition, in units of its noise ([`noise`]), that
+/// counts as variation. The 2nd–98th percentile span of pure Gaussian noise
+/// is ≈ 4.1 σ; 10 σ leaves a factor 2.4 above that, so noise alone (also
+/// mildly autocorrelated noise, whose short-record span is smaller still)
+/// never passes, while a drift of a few kPa against a ~0.1 kPa pressure
+/// sensor passes with a wide margin.
+pub const MIN_SPAN_NOISE: f64 = 10.0;
+
+/// The samples of one segment (clipped to the recording).
+fn of<'a>(samples: &'a [Sample], g: &Segment) -> &'a [Sample] {
+    let a = g.start.min(samples.len());
+    &samples[a..g.end.clamp(a, samples.len())]
+}
+
+/// Fewest finite samples of a segment that give it a noise estimate.
+const MIN_SEGMENT_SAMPLES: usize = 10;
+
+/// The noise of a recorded condition: the median over `segments` of the
+/// standard deviation of `get` about a straight line in time within the
+/// segment (a set point held, or a slow drift, leaves only the noise; the
+/// median keeps a few segments with a step inside from inflating it).
+/// NaN when no segment has [`MIN_SEGMENT_SAMPLES`] finite values.
+pub fn noise(samples: &[Sample], segments: &[&Segment], get: fn(&Sample) -> f64) -> f64 {
+    let mut sd: Vec<f64> = segments
+        .iter()
+        .filter_map(|g| detrended_sd(of(samples, g), get))
+        .collect();
+    if sd.is_empty() {
+        return f64::NAN;
+    }
+    sd.sort_by(f64::total_cmp);
+    sd[sd.len() / 2]
+}
+
+/// Standard deviation of `get` about its least-squares line in time (None
+/// with fewer than [`MIN_SEGMENT_SAMPLES`] finite values).
+fn detrended_sd(s: &[Sample], get: fn(&Sample) -> f64) -> Option<f64> {
+    let pts: Vec<(f64, f64)> = s
+        .iter()
+        .map(|x| (x.time, get(x)))
+        .filter(|(t, v)| t.is_finite() && v.is_finite())
+        .collect();
+    if pts.len() < MIN_SEGMENT_SAMPLES {
+        return None;
+    }
+    let n = pts.len() as f64;
+    let (mt, mv) = pts
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (t, v)| (a + t / n, b + v / n));
+    let (mut stv, mut stt) = (0.0, 0.0);
+    for (t, v) in &pts {
+        stv += (t - mt) * (v - mv);
+        stt += (t - mt) * (t - mt);
+    }
+    let k = if stt > 0.0 { stv / stt } else { 0.0 };
+    let ss: f64 = pts
+        .iter()
+        .map(|(t, v)| {
+            let e = v - mv - k * (t - mt);
+            e * e
+        })
+        .sum();
+    Some((ss / (n - 2.0)).sqrt())
+}
+
+/// The 2nd–98th percentile span of `get` over the samples of `segments`
+/// (robust against single spikes; NaN without finite values).
+pub fn span(samples: &[Sample], segments: &[&Segment], get: fn(&Sample) -> f64) -> f64 {
+    let mut v: Vec<f64> = segments
+        .iter()
+        .flat_map(|g| of(samples, g).iter())
+        .map(get)
+        .filter(|x| x.is_finite())
+        .collect();
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    let at = |q: f64| v[((q * (v.len() - 1) as f64).round() as usize).min(v.len() - 1)];
+    at(0.98) - at(0.02)
+}
+
+/// Whether `get` varies over `segments` by more than [`MIN_SPAN_NOISE`]
+/// times its noise, judged on `x` (the values compared: samples or
+/// segment means) against the samples' noise. A condition without noise
+/// (a simulated set point) varies when its values differ at all.
+pub fn varies_beyond_noise(x_span: f64, noise: f64) -> bool {
+    let sigma = if noise.is_finite() { noise } else { 0.0 };
+    x_span.is_finite() && x_span > 0.0 && x_span > MIN_SPAN_NOISE * sigma
+}
+
+/// Mean of `get` over one segment's finite samples (NaN without any).
+pub fn segment_mean(samples: &[Sample], g: &Segment, get: fn(&Sample) -> f64) -> f64 {
+    let (sum, n) = of(samples, g)
+        .iter()
+        .map(get)
+        .filter(|x| x.is_finite())
+        .fold((0.0, 0usize), |(a, n), x| (a + x, n + 1));
+    if n == 0 {
+        f64::NAN
+    } else {
+        sum / n as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::SegmentKind;
+
+    fn seg(start: usize, end: usize) -> Segment {
+        Segment {
+            start,
+            end,
+            kind: SegmentKind::PureLateral,
+            fz: 1000.0,
+            gamma: 0.0,
+            p: 2e5,
+            vx: 11.0,
+            alpha: f64::NAN,
+        }
+    }
+
+    /// A pressure drifting 4 kPa over the recording with a ±0.1 kPa
+    /// alternating "noise" varies; the same noise on a held pressure does not.
+    #[test]
+    fn drift_varies_noise_does_not() {
+        let n = 2000;
+        let mk = |drift: f64| -> Vec<Sample> {
+            (0..n)
+                .map(|i| Sample {
+                    time: i as f64 * 0.01,
+                    p: 2e5 + drift * i as f64 / n as f64 + if i % 2 == 0 { 100.0 } else { -100.0 },
+                    ..Default::default()
+                })
+                .collect()
+        };
+        let segs: Vec<Segment> = (0..10).map(|k| seg(200 * k, 200 * (k + 1))).collect();
+        let refs: Vec<&Segment> = segs.iter().collect();
+        let get: fn(&Sample) -> f64 = |s| s.p;
+        let held = mk(0.0);
+        let sigma = noise(&held, &refs, get);
+        // The alternating ±100 Pa has standard deviation 100 Pa.
+        assert!((sigma - 100.0).abs() < 2.0, "{sigma}");
+        assert!(!varies_beyond_noise(span(&held, &refs, get), sigma));
+        let drifting = mk(4000.0);
+        let sigma = noise(&drifting, &refs, get);
+        // The line in time removes the drift: still the noise.
+        assert!((sigma - 100.0).abs() < 2.0, "{sigma}");
+        assert!(varies_beyond_noise(span(&drifting, &refs, get), sigma));
+    }
+}

@@ -225,6 +225,11 @@ pub struct Spec {
     /// — at one pressure the pressure terms can only fit sensor noise on the
     /// recorded pressure and end at a bound.
     pub levels: Option<(fn(&crate::data::Segment) -> f64, f64)>,
+    /// Values taken from the fit half and written as they are (with
+    /// [`Spec::fixed`]), e.g. the knot loads of a curve over the recorded
+    /// load range; None from the function: the fit half cannot carry the
+    /// candidate (one load level), which is then the baseline itself.
+    pub from_data: Option<fn(&Recording, &[bool]) -> Option<Vec<(Target, f64)>>>,
 }
 
 /// Distinct levels of `levels` among the segments overlapping `mask`.
@@ -409,9 +414,15 @@ impl Candidate for ParamCandidate {
         mask: &[bool],
         w: &[f64; 3],
     ) -> Result<Box<dyn Fitted>> {
-        let Some(spec) = (self.spec)(baseline, opts) else {
+        let Some(mut spec) = (self.spec)(baseline, opts) else {
             return NoneCandidate.fit(rec, baseline, opts, mask, w);
         };
+        if let Some(f) = spec.from_data {
+            match f(rec, mask) {
+                Some(v) => spec.fixed.extend(v),
+                None => return NoneCandidate.fit(rec, baseline, opts, mask, w),
+            }
+        }
         // Only the parameters acting on a channel with data are fitted; the
         // others stay at their start (the file's value).
         let free: Vec<usize> = (0..spec.params.len())

@@ -1,12 +1,11 @@
 //! The relaxation candidate: named on a slip-lag truth, not on the control.
 
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
-use tyrekit::data::structure::sweep_and_time;
-use tyrekit::data::{Recording, SAMPLE_CHANNELS};
+mod common;
+
+use tyrekit::data::Recording;
 use tyrekit::diagnose::replay::ReplayOptions;
 use tyrekit::diagnose::report::diagnose;
-use tyrekit::mf::{Tyre, UseMode};
+use tyrekit::mf::Tyre;
 use tyrekit::rig::{effects, simulate, Noise, RigConfig};
 
 /// The rig's ISO-W truth of a short programme, with 12 N / 0.4 N·m white
@@ -19,40 +18,11 @@ fn recording(tyre: &Tyre, effect: &str) -> Recording {
     cfg.programme.loads.truncate(3);
     cfg.programme.db_alphas.truncate(2);
     let mut m = effects::concealed(effect, tyre.clone(), 1.0).unwrap();
-    let run = simulate(&cfg, m.as_mut());
-    let mut rng = ChaCha8Rng::seed_from_u64(5);
-    let mut g = || {
-        let u1: f64 = rng.gen::<f64>().max(1e-300);
-        let u2: f64 = rng.gen();
-        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-    };
-    let mut samples = run.truth;
-    for s in &mut samples {
-        s.fx += 12.0 * g();
-        s.fy += 12.0 * g();
-        s.mz += 0.4 * g();
-    }
-    let (sweep_dir, t_in_segment) = sweep_and_time(&samples, &run.plan);
-    Recording {
-        source: effect.into(),
-        samples,
-        channels: SAMPLE_CHANNELS.iter().map(|c| c.to_string()).collect(),
-        extra: vec![],
-        segments: run.plan,
-        sweep_dir,
-        t_in_segment,
-    }
+    common::noisy_recording(simulate(&cfg, m.as_mut()), effect, 12.0, 0.4, 5)
 }
 
 fn opts() -> ReplayOptions {
-    ReplayOptions {
-        use_mode: UseMode {
-            limits: false,
-            alpha_star: false,
-            turn_slip: false,
-        },
-        ..Default::default()
-    }
+    common::diagnose_opts()
 }
 
 #[test]

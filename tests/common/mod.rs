@@ -221,3 +221,53 @@ pub fn fit_sine(t: &[f64], y: &[f64], w: f64) -> (f64, f64) {
         .expect("regular normal equations");
     (x[0].hypot(x[1]), x[1].atan2(x[0]))
 }
+
+/// The replay options of the diagnosis tests: the MF's limits, α* and turn
+/// slip off (the rig's truth models run without them).
+pub fn diagnose_opts() -> tyrekit::diagnose::replay::ReplayOptions {
+    tyrekit::diagnose::replay::ReplayOptions {
+        use_mode: tyrekit::mf::UseMode {
+            limits: false,
+            alpha_star: false,
+            turn_slip: false,
+        },
+        ..Default::default()
+    }
+}
+
+/// A rig run as a recording, with white Gaussian sensor noise of `sd_f` (N)
+/// on Fx, Fy and `sd_mz` (N·m) on Mz drawn from `seed` (Box–Muller).
+pub fn noisy_recording(
+    run: tyrekit::rig::RigRun,
+    source: &str,
+    sd_f: f64,
+    sd_mz: f64,
+    seed: u64,
+) -> tyrekit::data::Recording {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut g = || {
+        let u1: f64 = rng.gen::<f64>().max(1e-300);
+        let u2: f64 = rng.gen();
+        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+    };
+    let mut samples = run.truth;
+    for s in &mut samples {
+        s.fx += sd_f * g();
+        s.fy += sd_f * g();
+        s.mz += sd_mz * g();
+    }
+    let (sweep_dir, t_in_segment) = tyrekit::data::structure::sweep_and_time(&samples, &run.plan);
+    tyrekit::data::Recording {
+        source: source.into(),
+        samples,
+        channels: tyrekit::data::SAMPLE_CHANNELS
+            .iter()
+            .map(|c| c.to_string())
+            .collect(),
+        extra: vec![],
+        segments: run.plan,
+        sweep_dir,
+        t_in_segment,
+    }
+}

@@ -5,7 +5,7 @@ mod common;
 use tyrekit::data::Recording;
 use tyrekit::diagnose::replay::ReplayOptions;
 use tyrekit::diagnose::report::diagnose;
-use tyrekit::mf::{Tyre, UseMode};
+use tyrekit::mf::Tyre;
 use tyrekit::rig::{effects, simulate, Noise, RigConfig};
 
 /// The rig's ISO-W truth of a short programme, with 12 N / 0.4 N·m white
@@ -18,19 +18,11 @@ fn recording(tyre: &Tyre, effect: &str) -> Recording {
     cfg.programme.loads.truncate(3);
     cfg.programme.db_alphas.truncate(2);
     let mut m = effects::concealed(effect, tyre.clone(), 1.0).unwrap();
-    let run = simulate(&cfg, m.as_mut());
-    common::noisy_rig_recording(effect, run.truth, run.plan, 5)
+    common::noisy_recording(simulate(&cfg, m.as_mut()), effect, 12.0, 0.4, 5)
 }
 
 fn opts() -> ReplayOptions {
-    ReplayOptions {
-        use_mode: UseMode {
-            limits: false,
-            alpha_star: false,
-            turn_slip: false,
-        },
-        ..Default::default()
-    }
+    common::diagnose_opts()
 }
 
 #[test]

@@ -24,7 +24,7 @@ use std::path::Path;
 use tyrekit::data::{load, LoadOptions, ReChoice, Recording};
 use tyrekit::diagnose::candidate::{self, all, evaluate, held_out_sse, select, Candidate};
 use tyrekit::diagnose::replay::{replay, ReplayOptions};
-use tyrekit::mf::{Forces, MfInput, Tyre, UseMode};
+use tyrekit::mf::{Forces, MfInput, Tyre};
 use tyrekit::rig::{effects, simulate, RigConfig, RigInput, TruthModel};
 
 const TYRES: [&str; 3] = [
@@ -60,14 +60,7 @@ fn config(tyre: &Tyre, effect: &str, seed: u64) -> RigConfig {
 }
 
 fn opts() -> ReplayOptions {
-    ReplayOptions {
-        use_mode: UseMode {
-            limits: false,
-            alpha_star: false,
-            turn_slip: false,
-        },
-        ..Default::default()
-    }
+    common::diagnose_opts()
 }
 
 /// Simulate, write a TTC .mat, read it back.

@@ -357,6 +357,13 @@ pub enum ScalingKind {
     /// A second load-sensitivity form: the classical power law of peak
     /// friction, s = (Fz/Fnom)^(−a), stiffness unchanged (a = strength).
     LoadPowerLaw,
+    /// A third load-sensitivity form: peak friction linear in load,
+    /// s = 1 − a·dfz, stiffness unchanged (a = strength).
+    LoadLinear,
+    /// A fourth load-sensitivity form, saturating: friction and stiffness
+    /// level off at both ends of the load range,
+    /// s = 1 − a·tanh(2·dfz), c = 1 + a·tanh(2·dfz) (a = strength).
+    LoadSaturating,
 }
 
 impl Scaling {
@@ -403,6 +410,11 @@ impl TruthModel for Scaling {
                 (1.0 - a * (1.0 - (-vs / 3.0).exp()), 1.0)
             }
             ScalingKind::LoadPowerLaw => ((1.0 + dfz).max(0.05).powf(-a), 1.0),
+            ScalingKind::LoadLinear => (1.0 - a * dfz, 1.0),
+            ScalingKind::LoadSaturating => {
+                let t = (2.0 * dfz).tanh();
+                (1.0 - a * t, 1.0 + a * t)
+            }
         };
         let f = scaled(&self.inner, m, k, ta, s, c);
         output(&self.inner, inp, f, f64::NAN)

@@ -7,10 +7,23 @@
 //! slip stiffness × c (`StepCtx::forces`, [`super::mf_at`]).
 //!
 //! The scales are a product of:
-//! * **load sensitivity** (`[LOAD_SENSITIVITY]`, keys `MU_DFZ1`, `MU_DFZ2`,
-//!   `K_DFZ1`): polynomial corrections in dfz = (Fz − Fz0)/Fz0 beyond the MF
-//!   forms, s = 1 + MU_DFZ1·dfz + MU_DFZ2·dfz², c = 1 + K_DFZ1·dfz — the
-//!   role the η-corrections play for heavy radial tyres.
+//! * **load sensitivity of general shape** (`[LOAD_SENSITIVITY]`, keys
+//!   `FZ1`…`FZ5` (N, increasing), `MU_FZ1`…, `K_FZ1`…, `MZ_FZ1`… (–)):
+//!   multipliers of friction, slip stiffness and aligning moment over the
+//!   load range, s = 1 + MU(Fz), c = 1 + K(Fz), Mz × (1 + MZ(Fz)), each a
+//!   natural cubic spline through the knots (Fz_i, MU_FZi) … (smooth, of no
+//!   fixed shape: it can rise, fall, level off or peak between knots) and
+//!   constant beyond the outer knots (no extrapolation past the loads the
+//!   data had) — a curve of any shape the
+//!   knots resolve, where the MF's own load forms (PDY2, PKY1–2, QDZ2 …:
+//!   Pacejka, *Tyre and Vehicle Dynamics*, 3rd ed., eqs. 4.E13–4.E40) fix it
+//!   to low-order functions of dfz. MZ scales the moment on top of the
+//!   similarity scaling (the pneumatic trail and residual moment of that
+//!   load): the data of a tyre whose cornering stiffness departs from the MF
+//!   form show Mz departing differently from Fy.
+//!   The older polynomial keys `MU_DFZ1`, `MU_DFZ2`, `K_DFZ1` (corrections
+//!   in dfz = (Fz − Fz0)/Fz0, s = 1 + MU_DFZ1·dfz + MU_DFZ2·dfz²,
+//!   c = 1 + K_DFZ1·dfz) are still read, and multiply with the curves.
 //! * **sliding-speed friction** (the MF's own `LMUV` with `LONGVL` = V0):
 //!   s = 1/(1 + LMUV·Vs/V0), Vs = |Vx|·√(κ² + tan²α) the sliding speed
 //!   (MF 6.1, Pacejka 3rd ed. eq. 4.E7: λμ* = λμ/(1 + λμV·Vs/V0)). The
@@ -72,8 +85,19 @@ use crate::tir::TyreParams;
 pub const SLOT_TEMP: usize = 3;
 /// Section of the load-sensitivity corrections.
 pub const LOAD_SECTION: &str = "LOAD_SENSITIVITY";
-/// Keys of [`LOAD_SECTION`].
+/// Polynomial keys of [`LOAD_SECTION`] (read, no longer written by the diagnosis).
 pub const LOAD_KEYS: [&str; 3] = ["MU_DFZ1", "MU_DFZ2", "K_DFZ1"];
+/// Most knots of the load curves ([`LoadCurve`]).
+pub const LOAD_KNOTS: usize = 5;
+/// Knot loads of [`LOAD_SECTION`] (N, strictly increasing, > 0; the first
+/// missing key ends the list, at least two when any is given).
+pub const LOAD_FZ_KEYS: [&str; LOAD_KNOTS] = ["FZ1", "FZ2", "FZ3", "FZ4", "FZ5"];
+/// Relative friction change at each knot (–, default 0).
+pub const LOAD_MU_KEYS: [&str; LOAD_KNOTS] = ["MU_FZ1", "MU_FZ2", "MU_FZ3", "MU_FZ4", "MU_FZ5"];
+/// Relative slip-stiffness change at each knot (–, default 0).
+pub const LOAD_K_KEYS: [&str; LOAD_KNOTS] = ["K_FZ1", "K_FZ2", "K_FZ3", "K_FZ4", "K_FZ5"];
+/// Relative aligning-moment change at each knot (–, default 0).
+pub const LOAD_MZ_KEYS: [&str; LOAD_KNOTS] = ["MZ_FZ1", "MZ_FZ2", "MZ_FZ3", "MZ_FZ4", "MZ_FZ5"];
 /// Section of the sliding-speed friction of general shape.
 pub const SPEED_SECTION: &str = "SPEED_FRICTION";
 /// Keys of [`SPEED_SECTION`]: the friction change at high sliding speed
@@ -178,11 +202,186 @@ impl SpeedLaw {
     }
 }
 
+/// Multipliers of friction, slip stiffness and aligning moment over the
+/// load: natural cubic splines through the knots (see the module docs),
+/// constant beyond the outer knots. Fixed-size: no allocation in the step.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct LoadCurve {
+    /// Number of knots in use (2..=[`LOAD_KNOTS`]).
+    pub n: usize,
+    /// Knot loads (N), strictly increasing.
+    pub fz: [f64; LOAD_KNOTS],
+    /// Relative friction change at each knot.
+    pub mu: [f64; LOAD_KNOTS],
+    /// Relative slip-stiffness change at each knot.
+    pub k: [f64; LOAD_KNOTS],
+    /// Relative aligning-moment change at each knot.
+    pub mz: [f64; LOAD_KNOTS],
+    /// The splines' second derivatives at the knots (mu, k, mz), from [`LoadCurve::new`].
+    d2: [[f64; LOAD_KNOTS]; 3],
+}
+
+/// Second derivatives of the natural cubic spline through (x, y)[..n]
+/// (zero at both ends; the tridiagonal system solved by the Thomas
+/// algorithm; de Boor, *A Practical Guide to Splines*, 1978, ch. IV).
+fn natural_d2(x: &[f64; LOAD_KNOTS], y: &[f64; LOAD_KNOTS], n: usize) -> [f64; LOAD_KNOTS] {
+    let mut m = [0.0; LOAD_KNOTS];
+    if n < 3 {
+        return m;
+    }
+    let (mut c, mut d) = ([0.0; LOAD_KNOTS], [0.0; LOAD_KNOTS]);
+    for i in 1..n - 1 {
+        let (h0, h1) = (x[i] - x[i - 1], x[i + 1] - x[i]);
+        let r = 6.0 * ((y[i + 1] - y[i]) / h1 - (y[i] - y[i - 1]) / h0);
+        let b = 2.0 * (h0 + h1) - if i > 1 { h0 * c[i - 1] } else { 0.0 };
+        c[i] = h1 / b;
+        d[i] = (r - if i > 1 { h0 * d[i - 1] } else { 0.0 }) / b;
+    }
+    for i in (1..n - 1).rev() {
+        m[i] = d[i] - c[i] * m[i + 1];
+    }
+    m
+}
+
+impl LoadCurve {
+    /// Curves through the knots `fz` (N, strictly increasing, 2..=5) with
+    /// the relative changes `mu`, `k`, `mz` there (same lengths).
+    pub fn new(fz: &[f64], mu: &[f64], k: &[f64], mz: &[f64]) -> LoadCurve {
+        let n = fz.len().min(LOAD_KNOTS);
+        let mut c = LoadCurve {
+            n,
+            ..Default::default()
+        };
+        for i in 0..n {
+            c.fz[i] = fz[i];
+            c.mu[i] = mu.get(i).copied().unwrap_or(0.0);
+            c.k[i] = k.get(i).copied().unwrap_or(0.0);
+            c.mz[i] = mz.get(i).copied().unwrap_or(0.0);
+        }
+        c.prepare();
+        c
+    }
+
+    fn prepare(&mut self) {
+        self.d2 = [
+            natural_d2(&self.fz, &self.mu, self.n),
+            natural_d2(&self.fz, &self.k, self.n),
+            natural_d2(&self.fz, &self.mz, self.n),
+        ];
+    }
+
+    /// Curve `j` (0 mu, 1 k, 2 mz) with knot values `v` at load `fz`.
+    #[inline]
+    fn at(&self, j: usize, v: &[f64; LOAD_KNOTS], fz: f64) -> f64 {
+        let n = self.n.clamp(1, LOAD_KNOTS);
+        if !(fz > self.fz[0]) {
+            return v[0];
+        }
+        let m = &self.d2[j];
+        for i in 1..n {
+            if fz < self.fz[i] {
+                let h = self.fz[i] - self.fz[i - 1];
+                let (a, b) = (self.fz[i] - fz, fz - self.fz[i - 1]);
+                return (m[i - 1] * a * a * a + m[i] * b * b * b) / (6.0 * h)
+                    + (v[i - 1] / h - m[i - 1] * h / 6.0) * a
+                    + (v[i] / h - m[i] * h / 6.0) * b;
+            }
+        }
+        v[n - 1]
+    }
+    /// Friction scale at `fz` (N).
+    #[inline]
+    pub fn friction(&self, fz: f64) -> f64 {
+        1.0 + self.at(0, &self.mu, fz)
+    }
+    /// Slip-stiffness scale at `fz` (N).
+    #[inline]
+    pub fn stiffness(&self, fz: f64) -> f64 {
+        1.0 + self.at(1, &self.k, fz)
+    }
+    /// Aligning-moment scale at `fz` (N).
+    #[inline]
+    pub fn moment(&self, fz: f64) -> f64 {
+        1.0 + self.at(2, &self.mz, fz)
+    }
+
+    /// The curves of a file, None without `FZ1`. Errors name the key.
+    fn from_params(t: &TyreParams) -> crate::Result<Option<LoadCurve>> {
+        let bad = |key: &str, msg: String| crate::Error::Tir {
+            file: t.source.clone(),
+            line: 0,
+            key: key.into(),
+            message: msg,
+        };
+        let mut c = LoadCurve::default();
+        for (i, key) in LOAD_FZ_KEYS.iter().enumerate() {
+            let Some(f) = number(t, LOAD_SECTION, key)? else {
+                break;
+            };
+            if !(f > 0.0) || (i > 0 && !(f > c.fz[i - 1])) {
+                return Err(bad(
+                    key,
+                    format!("[{LOAD_SECTION}] {key} = {f}: the knot loads must be positive (N) and strictly increasing"),
+                ));
+            }
+            c.fz[i] = f;
+            c.n = i + 1;
+        }
+        for (keys, v) in [
+            (&LOAD_MU_KEYS, &mut c.mu),
+            (&LOAD_K_KEYS, &mut c.k),
+            (&LOAD_MZ_KEYS, &mut c.mz),
+        ] {
+            for (i, key) in keys.iter().enumerate() {
+                if let Some(x) = number(t, LOAD_SECTION, key)? {
+                    if i >= c.n {
+                        return Err(bad(
+                            key,
+                            format!("[{LOAD_SECTION}] {key} has no knot load {} (give FZ1..FZ{} in order)", LOAD_FZ_KEYS[i], i + 1),
+                        ));
+                    }
+                    if !(x > -1.0) {
+                        return Err(bad(
+                            key,
+                            format!("[{LOAD_SECTION}] {key} = {x}: a relative change must be above -1 (the scale 1 + {key} must stay positive)"),
+                        ));
+                    }
+                    v[i] = x;
+                }
+            }
+        }
+        match c.n {
+            0 => Ok(None),
+            1 => Err(bad(
+                "FZ2",
+                format!("[{LOAD_SECTION}] needs at least two knot loads (FZ1, FZ2)"),
+            )),
+            _ => {
+                c.prepare();
+                Ok(Some(c))
+            }
+        }
+    }
+
+    /// Write the curves into `[LOAD_SECTION]`.
+    fn write_to(&self, t: &mut TyreParams) {
+        let s = t.extra_section(LOAD_SECTION);
+        for i in 0..self.n.min(LOAD_KNOTS) {
+            s.set(LOAD_FZ_KEYS[i], self.fz[i]);
+            s.set(LOAD_MU_KEYS[i], self.mu[i]);
+            s.set(LOAD_K_KEYS[i], self.k[i]);
+            s.set(LOAD_MZ_KEYS[i], self.mz[i]);
+        }
+    }
+}
+
 /// The extension physics of one tyre (None fields: not in the file).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct Extension {
     /// (MU_DFZ1, MU_DFZ2, K_DFZ1).
     pub load: Option<[f64; 3]>,
+    /// The load curves of [`LOAD_SECTION`].
+    pub load_curve: Option<LoadCurve>,
     /// LMUV and V0 (LONGVL, m/s).
     pub lmuv: Option<(f64, f64)>,
     /// The law of [`SPEED_SECTION`].
@@ -240,6 +439,7 @@ impl Extension {
         if any && load.iter().any(|x| *x != 0.0) {
             e.load = Some(load);
         }
+        e.load_curve = LoadCurve::from_params(t)?;
         if p.lmuv != 0.0 {
             if !p.lmuv.is_finite() || p.lmuv < 0.0 {
                 return Err(bad("LMUV", "expected a finite number >= 0"));
@@ -310,7 +510,12 @@ impl Extension {
             e.thermal = Some(m);
         }
         Ok(
-            if e.load.is_some() || e.lmuv.is_some() || e.speed.is_some() || e.thermal.is_some() {
+            if e.load.is_some()
+                || e.load_curve.is_some()
+                || e.lmuv.is_some()
+                || e.speed.is_some()
+                || e.thermal.is_some()
+            {
                 Some(e)
             } else {
                 None
@@ -326,6 +531,9 @@ impl Extension {
             for (k, v) in LOAD_KEYS.iter().zip(l) {
                 s.set(k, v);
             }
+        }
+        if let Some(c) = self.load_curve {
+            c.write_to(t);
         }
         if let Some((lmuv, _)) = self.lmuv {
             t.p.lmuv = lmuv;
@@ -355,6 +563,10 @@ impl Extension {
             s *= 1.0 + m1 * dfz + m2 * dfz * dfz;
             c *= 1.0 + k1 * dfz;
         }
+        if let Some(l) = &self.load_curve {
+            s *= l.friction(fz);
+            c *= l.stiffness(fz);
+        }
         if self.lmuv.is_some() || self.speed.is_some() {
             let slip = (kin.kappa * kin.kappa + kin.tan_alpha * kin.tan_alpha).sqrt();
             if let Some((lmuv, v0)) = self.lmuv {
@@ -369,6 +581,23 @@ impl Extension {
         }
         let g = |x: f64| if x.is_finite() { x.max(S_MIN) } else { 1.0 };
         (g(s), g(c))
+    }
+
+    /// Scale of the aligning moment at load `fz` (N) on top of the
+    /// similarity scaling ([`LoadCurve::moment`]; 1 without load curves).
+    #[inline]
+    pub fn moment_scale(&self, fz: f64) -> f64 {
+        match &self.load_curve {
+            Some(l) => {
+                let m = l.moment(fz);
+                if m.is_finite() {
+                    m.max(S_MIN)
+                } else {
+                    1.0
+                }
+            }
+            None => 1.0,
+        }
     }
 
     /// Advance the extension states over `dt` from `prev` into `next` with
@@ -518,5 +747,65 @@ mod tests {
         assert!(bad.unwrap_err().to_string().contains("DMU"));
         let bad = Extension::from_params(&with("[SPEED_FRICTION]\nDMU = 0.1\n"));
         assert!(bad.unwrap_err().to_string().contains("VC"));
+    }
+
+    /// The load curves: through the knots exactly, a straight line stays
+    /// straight (a natural spline reproduces linear data), a concave set of
+    /// knot values gives a smooth curve bending the same way between them,
+    /// constant beyond the outer knots; the keys read back and write back;
+    /// unordered knots, a missing knot load or a change ≤ −1 is refused
+    /// naming the key; the old polynomial keys still read.
+    #[test]
+    fn load_curves_interpolate_and_read_back() {
+        let c = LoadCurve::new(
+            &[1000.0, 2500.0, 6000.0],
+            &[-0.1, 0.02, 0.0],
+            &[0.05, 0.0, -0.05],
+            &[0.0, 0.1, 0.0],
+        );
+        for (i, f) in [1000.0, 2500.0, 6000.0].iter().enumerate() {
+            assert!((c.friction(*f) - 1.0 - c.mu[i]).abs() < 1e-12);
+            assert!((c.stiffness(*f) - 1.0 - c.k[i]).abs() < 1e-12);
+            assert!((c.moment(*f) - 1.0 - c.mz[i]).abs() < 1e-12);
+        }
+        // k is linear in Fz? No: (1000, .05), (2500, 0), (6000, -.05) is
+        // not collinear; a collinear set is reproduced exactly.
+        let lin = LoadCurve::new(&[1000.0, 2500.0, 6000.0], &[-0.1, 0.05, 0.4], &[], &[]);
+        for f in [1200.0, 2000.0, 3000.0, 5500.0] {
+            let want = -0.1 + 0.15 * (f - 1000.0) / 1500.0;
+            assert!((lin.friction(f) - 1.0 - want).abs() < 1e-12, "{f}");
+        }
+        // Concave knots (the mu set): the curve between them lies above
+        // the chords, and is continuous at the middle knot.
+        let chord = -0.1 + 0.12 * (1750.0 - 1000.0) / 1500.0;
+        assert!(c.friction(1750.0) - 1.0 > chord);
+        let e = 1e-6;
+        assert!((c.friction(2500.0 - e) - c.friction(2500.0 + e)).abs() < 1e-8);
+        // Constant beyond the outer knots.
+        assert_eq!(c.friction(200.0), c.friction(1000.0));
+        assert_eq!(c.friction(9000.0), c.friction(6000.0));
+        let t = with("[LOAD_SENSITIVITY]\nFZ1 = 1000\nFZ2 = 2500\nFZ3 = 6000\nMU_FZ1 = -0.1\nMU_FZ2 = 0.02\nMU_FZ3 = 0\nK_FZ1 = 0.05\nK_FZ3 = -0.05\nMZ_FZ2 = 0.1\n");
+        let e = Extension::from_params(&t).unwrap().unwrap();
+        assert_eq!(e.load_curve, Some(c));
+        let mut w = with("");
+        e.write_to(&mut w);
+        let back = TyreParams::from_tir_str(&w.to_tir_string(), "w.tir").unwrap();
+        assert_eq!(
+            Extension::from_params(&back).unwrap().unwrap().load_curve,
+            Some(c)
+        );
+        for (text, key) in [
+            ("FZ1 = 2000\nFZ2 = 1000\n", "FZ2"),
+            ("FZ1 = 1000\n", "FZ2"),
+            ("FZ1 = 1000\nFZ2 = 2000\nMU_FZ3 = 0.1\n", "MU_FZ3"),
+            ("FZ1 = 1000\nFZ2 = 2000\nK_FZ1 = -1.2\n", "K_FZ1"),
+        ] {
+            let r = Extension::from_params(&with(&format!("[LOAD_SENSITIVITY]\n{text}")));
+            let msg = r.unwrap_err().to_string();
+            assert!(msg.contains(key), "{text}: {msg}");
+        }
+        let old = with("[LOAD_SENSITIVITY]\nMU_DFZ1 = -0.1\nMU_DFZ2 = 0\nK_DFZ1 = 0\n");
+        let e = Extension::from_params(&old).unwrap().unwrap();
+        assert_eq!((e.load, e.load_curve), (Some([-0.1, 0.0, 0.0]), None));
     }
 }

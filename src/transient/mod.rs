@@ -982,6 +982,8 @@ impl TransientModel {
             }
         };
         if let Some(e) = ext {
+            // The load curve's aligning-moment scale (1 without one).
+            out.mz *= e.moment_scale(fz);
             e.advance(&self.state, &mut next, &out, dt);
         }
         if (!steady || brush.is_some()) && fz > FZ_OFF {

@@ -222,13 +222,49 @@ pub fn fit_sine(t: &[f64], y: &[f64], w: f64) -> (f64, f64) {
     (x[0].hypot(x[1]), x[1].atan2(x[0]))
 }
 
-/// A rig run's noise-free ISO-W samples and segments as a recording, with
-/// white sensor noise of 12 N on Fx and Fy and 0.4 N·m on Mz (the rig's
-/// default levels) from a fixed seed.
+/// The replay options of the diagnosis tests: the MF's limits, α* and turn
+/// slip off (the rig's truth models run without them).
+pub fn diagnose_opts() -> tyrekit::diagnose::replay::ReplayOptions {
+    tyrekit::diagnose::replay::ReplayOptions {
+        use_mode: tyrekit::mf::UseMode {
+            limits: false,
+            alpha_star: false,
+            turn_slip: false,
+        },
+        ..Default::default()
+    }
+}
+
+/// A rig run as a recording, with white Gaussian sensor noise of `sd_f` (N)
+/// on Fx, Fy and `sd_mz` (N·m) on Mz drawn from `seed` (Box–Muller).
+pub fn noisy_recording(
+    run: tyrekit::rig::RigRun,
+    source: &str,
+    sd_f: f64,
+    sd_mz: f64,
+    seed: u64,
+) -> tyrekit::data::Recording {
+    noisy_samples(source, run.truth, run.plan, sd_f, sd_mz, seed)
+}
+
+/// Noise-free ISO-W samples and segments (e.g. several rig runs joined) as
+/// a recording, with the rig's default sensor noise levels (12 N on Fx and
+/// Fy, 0.4 N·m on Mz) from a fixed seed.
 pub fn noisy_rig_recording(
+    source: &str,
+    samples: Vec<tyrekit::data::Sample>,
+    segments: Vec<tyrekit::data::Segment>,
+    seed: u64,
+) -> tyrekit::data::Recording {
+    noisy_samples(source, samples, segments, 12.0, 0.4, seed)
+}
+
+fn noisy_samples(
     source: &str,
     mut samples: Vec<tyrekit::data::Sample>,
     segments: Vec<tyrekit::data::Segment>,
+    sd_f: f64,
+    sd_mz: f64,
     seed: u64,
 ) -> tyrekit::data::Recording {
     use rand::{Rng, SeedableRng};
@@ -239,9 +275,9 @@ pub fn noisy_rig_recording(
         (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
     };
     for s in &mut samples {
-        s.fx += 12.0 * g();
-        s.fy += 12.0 * g();
-        s.mz += 0.4 * g();
+        s.fx += sd_f * g();
+        s.fy += sd_f * g();
+        s.mz += sd_mz * g();
     }
     let (sweep_dir, t_in_segment) = tyrekit::data::structure::sweep_and_time(&samples, &segments);
     tyrekit::data::Recording {

@@ -12,7 +12,7 @@
 //! | `relaxation` | LONGITUDINAL_STIFFNESS, LATERAL_STIFFNESS (σ = K/C; LSGKP, LSGAL for MF 5.2/PAC2002) | LM, replayed transient |
 //! | `lugre` | `[LUGRE]` SIGMA0X, SIGMA0Y (bristle stiffness), MUS (Stribeck ratio) | LM, replayed transient |
 //! | `thermal` | `[THERMAL]` CAPACITY (time constant with COOLING = 40 W/K, SHARE = 0.5), MU_T0..2 | LM, replayed (tread-temperature state) |
-//! | `load_sensitivity` | `[LOAD_SENSITIVITY]` MU_DFZ1, MU_DFZ2, K_DFZ1 | LM on a subsample (static) |
+//! | `load_sensitivity` | `[LOAD_SENSITIVITY]` FZ1..3 (knot loads from the fit half), MU_FZ1..3, K_FZ1..3 (natural splines of friction and slip stiffness over the load) | LM on a subsample (static) |
 //! | `pressure` | PPX1, PPX3 (with Fx data), PPY1, PPY3 (with Fy/Mz data), PPZ1 (with Mz data) (MF 6.x only: MF 5.2/PAC2002 have no pressure terms; needs a recorded pressure that varies beyond its noise, [`crate::diagnose::factor`]) | LM, static |
 //! | `speed_friction` | `[SPEED_FRICTION]` DMU, VC, VREF (s = g(Vs)/g(σ·VREF), g(v) = 1 − DMU·x/(1 + x), x = v/VC) | LM from two starts, static |
 //! | `rolling_radius` | Q_RE0, FREFF (Re(Fz)); κ re-derived as (1+κ)·Re/Re_baseline − 1 | LM, static |

@@ -246,6 +246,11 @@ pub struct Spec {
     /// only when its values over the fit half span clearly more than their
     /// noise ([`crate::diagnose::factor::varies_beyond_noise`]).
     pub varies: Option<fn(&crate::data::Sample) -> f64>,
+    /// Values taken from the fit half and written as they are (with
+    /// [`Spec::fixed`]), e.g. the knot loads of a curve over the recorded
+    /// load range; None from the function: the fit half cannot carry the
+    /// candidate (one load level), which is then the baseline itself.
+    pub from_data: Option<fn(&Recording, &[bool]) -> Option<Vec<(Target, f64)>>>,
 }
 
 /// Whether `get` varies beyond its noise over the segments overlapping `mask`.
@@ -444,9 +449,15 @@ impl Candidate for ParamCandidate {
         mask: &[bool],
         w: &[f64; 3],
     ) -> Result<Box<dyn Fitted>> {
-        let Some(spec) = (self.spec)(baseline, opts) else {
+        let Some(mut spec) = (self.spec)(baseline, opts) else {
             return NoneCandidate.fit(rec, baseline, opts, mask, w);
         };
+        if let Some(f) = spec.from_data {
+            match f(rec, mask) {
+                Some(v) => spec.fixed.extend(v),
+                None => return NoneCandidate.fit(rec, baseline, opts, mask, w),
+            }
+        }
         // Only the parameters acting on a channel with data are fitted; the
         // others stay at their start (the file's value).
         let free: Vec<usize> = (0..spec.params.len())

@@ -88,3 +88,48 @@ pub(super) fn candidate() -> ParamCandidate {
         },
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The built-in tyre with its nominal load set to `fz0` (N).
+    fn tyre(fz0: f64) -> Tyre {
+        let mut p = Tyre::builtin().params().clone();
+        p.p.fnomin = fz0;
+        p.p.lfzo = 1.0;
+        Tyre::new(p).unwrap()
+    }
+
+    /// The cooling written follows the nominal load (40 W/K at 4000 N, the
+    /// rig's), and the capacity range with it: a 1000 N and an 8000 N tyre
+    /// get h 10 and 80 W/K and the same time-constant range and start
+    /// (C/h, to rounding), so the node warms by the same ΔT at the same
+    /// power per newton of nominal load and the friction coefficients'
+    /// bounds mean the same on both.
+    #[test]
+    fn cooling_and_capacity_follow_the_nominal_load() {
+        let ro = ReplayOptions::default();
+        let mut seen = Vec::new();
+        for (fz0, h_expected) in [(1000.0, 10.0), (4000.0, 40.0), (8000.0, 80.0)] {
+            let s = thermal_spec(&tyre(fz0), &ro).unwrap();
+            let h = s
+                .fixed
+                .iter()
+                .find_map(|(t, v)| match t {
+                    Target::Section(_, "COOLING") => Some(*v),
+                    _ => None,
+                })
+                .unwrap();
+            assert!((h - h_expected).abs() < 1e-9, "Fz0 {fz0}: h {h}");
+            let c = s.params.iter().find(|q| q.name == "CAPACITY").unwrap();
+            let tau = [c.init / h, c.lo / h, c.hi / h];
+            seen.push(tau);
+        }
+        for t in &seen {
+            for (a, b) in t.iter().zip([TAU_INIT, TAU_RANGE.0, TAU_RANGE.1]) {
+                assert!((a - b).abs() < 1e-9 * b, "{t:?}");
+            }
+        }
+    }
+}

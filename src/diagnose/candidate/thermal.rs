@@ -1,5 +1,19 @@
 //! thermal — a tread temperature driven by frictional power with friction depending on it (`[THERMAL]` section, see crate::transient::extension).
 //!
+//! The scale of the temperature: the node's rise at a steady frictional
+//! power P is ΔT = SHARE·P/COOLING, and the friction curve is a quadratic
+//! in x = ΔT/50 K with bounded coefficients. Frictional power grows with
+//! the load a tyre is built for (P ≈ μ·Fz·Vs), and so does the surface
+//! that sheds the heat; with one fixed COOLING a small tyre's node hardly
+//! warms (the dev set's FSAE-size r14: ΔT ≈ 12 K at 1 kW, x ≤ 0.3, where the
+//! bounded curvature cannot follow the data: MU_T2 ended at its bound) and
+//! a large one's runs far beyond 50 K. COOLING is therefore written in
+//! proportion to the nominal load, 40 W/K per 4000 N of Fz0 = FNOMIN·LFZO
+//! (the rig's and the old default at 4000 N), and CAPACITY's range with it,
+//! so the fitted time constant C/h keeps its range (5–2500 s) and the
+//! coefficients' bounds mean the same friction change on every tyre size.
+//! Files written before keep their own COOLING and read unchanged.
+//!
 //! Must never: fit a parameter outside the range written here, or describe
 //! a value the fit did not produce.
 
@@ -8,16 +22,40 @@ use crate::mf::Tyre;
 use crate::residual::ReplayOptions;
 use crate::transient::extension::THERMAL_SECTION;
 
-fn thermal_spec(_: &Tyre, _: &ReplayOptions) -> Option<Spec> {
+/// Cooling per newton of nominal load (W/K/N): 40 W/K at Fz0 = 4000 N.
+const COOLING_PER_N: f64 = 40.0 / 4000.0;
+/// Range of the time constant C/h (s): a few seconds (a thin tread skin
+/// at a fast belt) to ~40 min (a carcass heating over a whole test).
+const TAU_RANGE: (f64, f64) = (5.0, 2500.0);
+/// Start of the time constant (s): 100 s, a tread layer's order.
+const TAU_INIT: f64 = 100.0;
+
+/// The fixed cooling h (W/K) for a tyre: in proportion to its nominal load.
+fn cooling(t: &Tyre) -> f64 {
+    let p = &t.params().p;
+    let fz0 = p.fnomin * p.lfzo;
+    let fz0 = if fz0.is_finite() && fz0 > 0.0 { fz0 } else { 4000.0 };
+    COOLING_PER_N * fz0
+}
+
+fn thermal_spec(t: &Tyre, _: &ReplayOptions) -> Option<Spec> {
     let th = |k| Target::Section(THERMAL_SECTION, k);
+    let h = cooling(t);
     Some(Spec {
         params: vec![
-            p("CAPACITY", vec![th("CAPACITY")], 4000.0, 200.0, 1e5, 200.0),
+            p(
+                "CAPACITY",
+                vec![th("CAPACITY")],
+                TAU_INIT * h,
+                TAU_RANGE.0 * h,
+                TAU_RANGE.1 * h,
+                2.0 * h,
+            ),
             p("MU_T0", vec![th("MU_T0")], 0.0, -0.5, 0.5, 0.002),
             p("MU_T1", vec![th("MU_T1")], 0.0, -1.0, 1.0, 0.002),
             p("MU_T2", vec![th("MU_T2")], 0.0, -1.0, 1.0, 0.002),
         ],
-        fixed: vec![(th("COOLING"), 40.0), (th("SHARE"), 0.5)],
+        fixed: vec![(th("COOLING"), h), (th("SHARE"), 0.5)],
         sequential: true,
         ..Spec::default()
     })
@@ -32,16 +70,66 @@ pub(super) fn candidate() -> ParamCandidate {
         spec: thermal_spec,
         words: |f| {
             let c = param(f, "CAPACITY");
+            let h = f
+                .tyre()
+                .extension()
+                .and_then(|e| e.thermal)
+                .map_or(f64::NAN, |m| m.cooling);
             let m = |x: f64| {
                 100.0 * (param(f, "MU_T0") + param(f, "MU_T1") * x + param(f, "MU_T2") * x * x)
             };
             format!(
-                "a tread heat capacity of {c:.0} J/K (time constant {:.0} s with 40 W/K cooling); friction {:+.1} % at ambient, {:+.1} % at +25 K, {:+.1} % at +50 K",
-                c / 40.0,
+                "a tread heat capacity of {c:.0} J/K (time constant {:.0} s with {h:.1} W/K cooling); friction {:+.1} % at ambient, {:+.1} % at +25 K, {:+.1} % at +50 K",
+                c / h,
                 m(0.0),
                 m(0.5),
                 m(1.0)
             )
         },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The built-in tyre with its nominal load set to `fz0` (N).
+    fn tyre(fz0: f64) -> Tyre {
+        let mut p = Tyre::builtin().params().clone();
+        p.p.fnomin = fz0;
+        p.p.lfzo = 1.0;
+        Tyre::new(p).unwrap()
+    }
+
+    /// The cooling written follows the nominal load (40 W/K at 4000 N, the
+    /// rig's), and the capacity range with it: a 1000 N and an 8000 N tyre
+    /// get h 10 and 80 W/K and the same time-constant range and start
+    /// (C/h, to rounding), so the node warms by the same ΔT at the same
+    /// power per newton of nominal load and the friction coefficients'
+    /// bounds mean the same on both.
+    #[test]
+    fn cooling_and_capacity_follow_the_nominal_load() {
+        let ro = ReplayOptions::default();
+        let mut seen = Vec::new();
+        for (fz0, h_expected) in [(1000.0, 10.0), (4000.0, 40.0), (8000.0, 80.0)] {
+            let s = thermal_spec(&tyre(fz0), &ro).unwrap();
+            let h = s
+                .fixed
+                .iter()
+                .find_map(|(t, v)| match t {
+                    Target::Section(_, "COOLING") => Some(*v),
+                    _ => None,
+                })
+                .unwrap();
+            assert!((h - h_expected).abs() < 1e-9, "Fz0 {fz0}: h {h}");
+            let c = s.params.iter().find(|q| q.name == "CAPACITY").unwrap();
+            let tau = [c.init / h, c.lo / h, c.hi / h];
+            seen.push(tau);
+        }
+        for t in &seen {
+            for (a, b) in t.iter().zip([TAU_INIT, TAU_RANGE.0, TAU_RANGE.1]) {
+                assert!((a - b).abs() < 1e-9 * b, "{t:?}");
+            }
+        }
     }
 }

@@ -255,7 +255,10 @@ fn devset_diagnosis_does_not_regress() {
     let Some(v) = outcomes() else { return };
     let (n, ne, c, nc, _) = summary(v);
     if ne + nc < 21 {
-        eprintln!("NOTE partial run ({} recordings): the named-count guard needs all 21", ne + nc);
+        eprintln!(
+            "NOTE partial run ({} recordings): the named-count guard needs all 21",
+            ne + nc
+        );
         assert_eq!(c, nc, "a control was given a physical name");
         return;
     }

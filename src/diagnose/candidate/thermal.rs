@@ -34,7 +34,11 @@ const TAU_INIT: f64 = 100.0;
 fn cooling(t: &Tyre) -> f64 {
     let p = &t.params().p;
     let fz0 = p.fnomin * p.lfzo;
-    let fz0 = if fz0.is_finite() && fz0 > 0.0 { fz0 } else { 4000.0 };
+    let fz0 = if fz0.is_finite() && fz0 > 0.0 {
+        fz0
+    } else {
+        4000.0
+    };
     COOLING_PER_N * fz0
 }
 

@@ -891,9 +891,13 @@ pub fn from_raw(raw: RawTable, format: Format, file: &str, opts: &LoadOptions) -
             .find(|(nm, _)| nm == "Re")
             .map(|(_, v)| v.as_slice());
         let rl = rl_col.as_deref();
+        let sr = extra
+            .iter()
+            .find(|(nm, _)| nm.eq_ignore_ascii_case("SR"))
+            .map(|(_, v)| v.as_slice());
         let omega_ok = channels.iter().any(|c| c == "omega");
         let computed = if omega_ok {
-            slip::compute_kappa(&mut samples, re, rl, &opts.re)
+            slip::compute_kappa(&mut samples, re, rl, sr, &opts.re)
         } else {
             None
         };

@@ -8,6 +8,14 @@
 //! or brake torque it follows the slip itself (κ from it would be ≈ 0), which
 //! is why the default fits Re(Fz) on the free-rolling samples only.
 //!
+//! Where the rig also records its own slip ratio SR (TTC), the default reads
+//! the radius that SR was computed with, Vx·(1 + SR)/Ω, as a smooth function
+//! of load and wheel speed ([`slip_channel_radius`]): κ then follows the
+//! recording's slip ratio, as a user of the data reads it, while staying a
+//! κ = Ω·Re/Vx − 1 of one radius function the tyre file can carry. Whether
+//! that radius is the tyre's own free-rolling radius is a question for the
+//! diagnosis (`rolling_radius`), not for the loader.
+//!
 //! Must never: divide by a zero speed (such samples get κ = NaN and are then
 //! dropped and counted by the loader).
 
@@ -76,6 +84,99 @@ pub fn model_radii(tyre: &crate::mf::Tyre, fz: f64, re: f64, rl: f64) -> (f64, f
     (re, rl)
 }
 
+/// Most departure (RMS, relative) of the radius a slip-ratio channel implies
+/// from its smooth fit for the channel to count as computed from one radius
+/// function. The departure holds the wheel-speed and belt-speed noise (the
+/// dev-set rigs: 0.11–0.12 %, random, averaging out over a sweep) beside
+/// any systematic part; 3e-3 leaves room for that noise while a channel
+/// that is not a Ω·R/V − 1 of the wheel speed (the wrong speed reference:
+/// 0.5 % on the same rigs; coarse quantisation; another slip definition) is
+/// not used.
+pub const SLIP_CHANNEL_RMS: f64 = 3e-3;
+
+/// The radius a recorded slip ratio implies, R = Vx·(1 + SR)/Ω, fitted over
+/// the rolling samples as R = a + b·Fz + c·Fz² + d·Ω² (a radius that varies
+/// smoothly with load and, through the centrifugal growth, with wheel
+/// speed). Returns the fitted radius per sample and the RMS relative
+/// departure; None when fewer than 20 samples roll, the channel carries no
+/// information (SR ≡ 0 with slip in the data), or the departure exceeds
+/// [`SLIP_CHANNEL_RMS`].
+pub fn slip_channel_radius(samples: &[Sample], sr: &[f64]) -> Option<(Vec<f64>, f64)> {
+    let ok = |s: &Sample, r: f64| {
+        s.omega.is_finite()
+            && s.omega > 1.0
+            && s.vx.is_finite()
+            && s.vx > 1.0
+            && s.fz.is_finite()
+            && s.fz > 0.0
+            && r.is_finite()
+            && r.abs() < 0.3
+    };
+    let fmax = samples
+        .iter()
+        .filter(|s| s.fz.is_finite())
+        .map(|s| s.fz)
+        .fold(0.0, f64::max);
+    let wmax = samples
+        .iter()
+        .filter(|s| s.omega.is_finite())
+        .map(|s| s.omega)
+        .fold(0.0, f64::max);
+    if fmax <= 0.0 || wmax <= 0.0 {
+        return None;
+    }
+    // Columns scaled to O(1) for the normal equations.
+    let row = |s: &Sample| {
+        let (f, w) = (s.fz / fmax, s.omega / wmax);
+        [1.0, f, f * f, w * w]
+    };
+    let mut ata = nalgebra::Matrix4::<f64>::zeros();
+    let mut aty = nalgebra::Vector4::<f64>::zeros();
+    let mut n = 0usize;
+    let mut moving = 0usize;
+    for (s, &r) in samples.iter().zip(sr) {
+        if !ok(s, r) || s.fz < 0.05 * fmax {
+            continue;
+        }
+        let y = s.vx * (1.0 + r) / s.omega;
+        let a = nalgebra::Vector4::from(row(s));
+        ata += a * a.transpose();
+        aty += a * y;
+        n += 1;
+        moving += usize::from(r != 0.0);
+    }
+    if n < 20 || moving < n / 10 {
+        return None;
+    }
+    let c = ata.lu().solve(&aty)?;
+    let fit = |s: &Sample| c.dot(&nalgebra::Vector4::from(row(s)));
+    let mut ss = 0.0;
+    for (s, &r) in samples.iter().zip(sr) {
+        if ok(s, r) && s.fz >= 0.05 * fmax {
+            let y = s.vx * (1.0 + r) / s.omega;
+            ss += ((fit(s) - y) / y).powi(2);
+        }
+    }
+    let rms = (ss / n as f64).sqrt();
+    if !(rms <= SLIP_CHANNEL_RMS) {
+        return None;
+    }
+    let radii: Vec<f64> = samples
+        .iter()
+        .map(|s| {
+            if s.fz.is_finite() && s.omega.is_finite() {
+                fit(s)
+            } else {
+                f64::NAN
+            }
+        })
+        .collect();
+    radii
+        .iter()
+        .all(|r| !r.is_finite() || *r > 0.0)
+        .then_some((radii, rms))
+}
+
 /// κ for one sample given Re.
 #[inline]
 pub fn kappa(omega: f64, re: f64, vx: f64) -> f64 {
@@ -91,6 +192,7 @@ pub fn compute_kappa(
     samples: &mut [Sample],
     re: Option<&[f64]>,
     rl: Option<&[f64]>,
+    sr: Option<&[f64]>,
     choice: &ReChoice,
 ) -> Option<String> {
     if samples.iter().all(|s| !s.omega.is_finite()) || samples.iter().all(|s| !s.vx.is_finite()) {
@@ -98,6 +200,15 @@ pub fn compute_kappa(
     }
     let mut choice = choice.clone();
     if let ReChoice::FreeRolling = choice {
+        if let Some((radii, rms)) = sr.and_then(|v| slip_channel_radius(samples, v)) {
+            for (s, r) in samples.iter_mut().zip(&radii) {
+                s.kappa = kappa(s.omega, *r, s.vx);
+            }
+            return Some(format!(
+                "κ = Ω·Re/Vx − 1 with Re(Fz, Ω) the radius the recorded slip ratio SR was computed with (Vx·(1 + SR)/Ω, fitted smooth in load and wheel speed; RMS departure {:.2} %): κ follows SR",
+                100.0 * rms
+            ));
+        }
         if let Some((a, b)) = re.and_then(|r| free_rolling_re(samples, r)) {
             for s in samples.iter_mut() {
                 s.kappa = kappa(s.omega, a + b * s.fz, s.vx);

@@ -2,7 +2,9 @@
 //! the residual stage ([`crate::residual`]: replay, channels, scores), locate
 //! where the residuals concentrate with a statistic and a significance for
 //! each grouping ([`locate`]), fit the baseline when none is given
-//! ([`baseline`]), name, model and fit the physics left out ([`candidate`]),
+//! ([`baseline`]), name, model and fit the physics left out ([`candidate`];
+//! a rolling radius the forces cannot show, from the recorded slip ratio
+//! against the free-rolling radius: [`slip_channel`]),
 //! explain and score it ([`report`]) and draw it ([`plots`], [`html`]).
 //!
 //! Must never: judge structure without a significance (noise must not look
@@ -24,3 +26,4 @@ pub mod replay {
     };
 }
 pub mod report;
+pub mod slip_channel;

@@ -27,10 +27,12 @@
 //! (the selection rule decides), or call a grouping significant that
 //! [`locate`] did not.
 
+use super::candidate::param::rerolled;
 use super::candidate::{
     all, channels_in_words, evaluate, select, why_not, Candidate, ChannelScore, Evaluation,
 };
 use super::locate::{frictional_energy, locate, Finding, LocateOptions, Residuals};
+use super::slip_channel;
 use crate::data::Recording;
 use crate::error::Result;
 use crate::fit::metrics::{self, nrmse, sigma};
@@ -556,6 +558,10 @@ pub struct DiagnosisReport {
     pub candidates_implemented: Vec<&'static str>,
     /// The baseline against the data's noise floor ([`baseline_fit`]).
     pub baseline_fit: Vec<BaselineFit>,
+    /// The recorded slip ratio against the free-rolling radius
+    /// ([`slip_channel::check`]); absent without an SR channel.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub slip_channel: Option<slip_channel::SlipChannel>,
     pub samples: usize,
     pub segments: usize,
     /// How the baseline was obtained (set by the command).
@@ -645,7 +651,29 @@ pub fn diagnose_with(
     let ev = ev?;
     step("report");
     let verdict_i = select(&ev);
-    let verdict = verdict_i.map_or("none".to_string(), |i| ev[i].0.name.clone());
+    // The slip channel against the free-rolling radius: a rolling-radius
+    // finding the force residuals cannot make (see [`slip_channel`]). It
+    // names the verdict when no force candidate qualifies, and is added to
+    // the explanation otherwise.
+    let slip = slip_channel::check(rec, tyre);
+    let slip_ext = match slip.as_ref().filter(|s| s.found) {
+        Some(s) => Some(s.extended(tyre)?),
+        None => None,
+    };
+    let slip_words = slip
+        .as_ref()
+        .zip(slip_ext.as_ref())
+        .map(|(s, t)| s.words(tyre, t));
+    let slip_verdict = verdict_i.is_none() && slip_ext.is_some();
+    let slip_sim = match (&slip_ext, slip_verdict) {
+        (Some(t), true) => Some(replay(&rerolled(rec, tyre, t, opts), t, opts)?.sim),
+        _ => None,
+    };
+    let verdict = if slip_verdict {
+        "rolling_radius".to_string()
+    } else {
+        verdict_i.map_or("none".to_string(), |i| ev[i].0.name.clone())
+    };
     let (fit_r, test_r) = split(rec);
     let mask = |rs: &[Range<usize>]| {
         let mut m = vec![false; rec.samples.len()];
@@ -660,11 +688,14 @@ pub fn diagnose_with(
     order.sort_by_key(|&i| usize::from(ev[i].0.name != verdict));
     let before = nrmse_per_channel(rec, &base.sim, None);
     let before_oos = nrmse_per_channel(rec, &base.sim, Some(&test_mask));
-    let mut extended_sim = base.sim.clone();
+    let mut extended_sim = slip_sim.clone().unwrap_or_else(|| base.sim.clone());
     for i in order {
         let (e, fitted) = &ev[i];
+        let by_slip = slip_verdict && e.name == "rolling_radius";
         let sim = if e.name == "none" {
             base.sim.clone()
+        } else if let (true, Some(s)) = (by_slip, &slip_sim) {
+            s.clone()
         } else {
             fitted.predict(rec)?
         };
@@ -674,7 +705,13 @@ pub fn diagnose_with(
             delta_bic: e.delta_bic,
             n_params: e.n_params,
             evidence: format!(
-                "{}fitted on one half of the segments, scored on the other: removes {:.1} % of the baseline's held-out squared error (per channel: {}; BIC change {:+.1}){}{}",
+                "{}{}fitted on one half of the segments, scored on the other: removes {:.1} % of the baseline's held-out squared error (per channel: {}; BIC change {:+.1}){}{}",
+                match (&slip_words, by_slip) {
+                    (Some(w), true) => format!(
+                        "Named from the slip channel, not from the force residuals: {w} The radius keys alone, "
+                    ),
+                    _ => String::new(),
+                },
                 if e.name == "none" {
                     String::new()
                 } else {
@@ -712,7 +749,7 @@ pub fn diagnose_with(
     let fit_mask = mask(&fit_r);
     let base_fit = baseline_fit(rec, &base.sim, &fit_mask, &test_mask);
     let mut explanation = explain(&findings, verdict_i.map(|i| &ev[i].0), best_other, alpha);
-    if verdict_i.is_none() {
+    if verdict_i.is_none() && !slip_verdict {
         if let Some(m) = misfit_note(&base_fit) {
             explanation = format!("{m} {explanation}");
         }
@@ -729,6 +766,13 @@ pub fn diagnose_with(
             ));
         }
     }
+    if let Some(w) = &slip_words {
+        explanation = if slip_verdict {
+            format!("{w} (The force residuals alone name nothing: {explanation})")
+        } else {
+            format!("{explanation} Also: {w}")
+        };
+    }
     if verdict_i.is_some() {
         if let Some(c) = caution(&out_of_sample) {
             explanation.push(' ');
@@ -739,7 +783,10 @@ pub fn diagnose_with(
         .iter()
         .map(|(ch, f)| (ch.key(), f.clone()))
         .collect();
-    let extended = verdict_i.map_or_else(|| tyre.clone(), |i| ev[i].1.tyre().clone());
+    let extended = match (&slip_ext, slip_verdict) {
+        (Some(t), true) => t.clone(),
+        _ => verdict_i.map_or_else(|| tyre.clone(), |i| ev[i].1.tyre().clone()),
+    };
     let report = DiagnosisReport {
         verdict: verdict.clone(),
         explanation: explanation.clone(),
@@ -753,6 +800,7 @@ pub fn diagnose_with(
         locate,
         candidates_implemented: owned.iter().map(|c| c.name()).collect(),
         baseline_fit: base_fit,
+        slip_channel: slip,
         samples: rec.samples.len(),
         segments: rec.segments.len(),
         baseline: None,
@@ -774,11 +822,26 @@ pub fn diagnose_with(
 }
 
 /// Concatenate recordings (each later one shifted in time behind a gap, so
-/// the replay resets between them).
+/// the replay resets between them), extra channels included.
 pub fn merge(recs: Vec<Recording>) -> Recording {
     let mut out = Recording::default();
     let mut t_end = f64::NEG_INFINITY;
+    // Extra channels (the rig's SR, radii, temperatures) by name, NaN on the
+    // recordings that lack one.
+    for r in &recs {
+        for (n, _) in &r.extra {
+            if !out.extra.iter().any(|(m, _)| m == n) {
+                out.extra.push((n.clone(), Vec::new()));
+            }
+        }
+    }
     for r in recs {
+        for (n, v) in out.extra.iter_mut() {
+            match r.extra.iter().find(|(m, _)| m == n) {
+                Some((_, w)) if w.len() == r.samples.len() => v.extend_from_slice(w),
+                _ => v.extend(std::iter::repeat_n(f64::NAN, r.samples.len())),
+            }
+        }
         let off = if out.samples.is_empty() {
             0.0
         } else {

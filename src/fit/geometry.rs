@@ -1,7 +1,10 @@
 //! geometry — the tyre's own size and radii from a recording: unloaded
 //! radius, effective rolling radius keys (Q_RE0, Q_V1, BREFF, DREFF, FREFF)
-//! and vertical stiffness keys (VERTICAL_STIFFNESS, Q_FZ2) from the recorded
-//! effective radius Re = V/Ω and loaded radius Rl of free-rolling samples.
+//! and vertical stiffness keys (VERTICAL_STIFFNESS, Q_FZ2) from the
+//! effective radius and loaded radius Rl of free-rolling samples. The
+//! effective radius is the one the recording's κ was computed with,
+//! Vx·(1 + κ)/Ω (one radius source: the FMU, given Ω, then sees the slip the
+//! force fit saw — see [`crate::data::slip`]), else the recorded Re = V/Ω.
 //!
 //! The MF 6.1 radii (Besselink, Schmeitz & Pacejka, VSD 48 (2010), eqs. 1,
 //! 4, 7; Pacejka, *Tire and Vehicle Dynamics*, 3rd ed., eq. A3.3; MFeval's
@@ -164,9 +167,15 @@ fn free_samples_by(recs: &[Recording], use_sr: bool, p0: f64) -> Vec<Free> {
                 ..
             } = *s;
             // With a recorded slip ratio, free rolling is |SR| < SR_FREE (Fx
-            // may carry offsets and rolling resistance); else |Fx| < 5 % Fz.
+            // may carry offsets and rolling resistance) or a pure lateral
+            // sweep (whatever SR says: a rig whose SR is computed with
+            // another radius than the tyre's shows a load-dependent SR
+            // there); else |Fx| < 5 % Fz.
             let (fx_ok, sr_ok) = match sr.map(|v| v[i]).filter(|x| x.is_finite()) {
-                Some(x) => (!fx.is_finite() || fx.abs() < 0.15 * fz, x.abs() < SR_FREE),
+                Some(x) => (
+                    !fx.is_finite() || fx.abs() < 0.15 * fz,
+                    x.abs() < SR_FREE || lateral[i],
+                ),
                 None => (lateral[i] || !fx.is_finite() || fx.abs() < 0.05 * fz, true),
             };
             if !(fz > 0.1 * fmax && alpha.abs() < lim && fx_ok && sr_ok) {
@@ -175,8 +184,16 @@ fn free_samples_by(recs: &[Recording], use_sr: bool, p0: f64) -> Vec<Free> {
             if !(omega.is_finite() && omega > 1.0) {
                 continue;
             }
-            // The recorded Re, else V/Ω (what a flat-track rig records as RE).
-            let re_i = re.map_or(f64::NAN, |v| v[i]);
+            // One radius source: the radius the recording's κ was computed
+            // with, Vx·(1 + κ)/Ω, so that the file's Re(Fz) gives the FMU
+            // (κ from Ω) the slip the fit saw; else the recorded Re, else
+            // V/Ω (what a flat-track rig records as RE).
+            let implied = vx * (1.0 + s.kappa) / omega;
+            let re_i = if implied.is_finite() {
+                implied
+            } else {
+                re.map_or(f64::NAN, |v| v[i])
+            };
             let re_i = if re_i.is_finite() { re_i } else { vx / omega };
             if !(0.05..=5.0).contains(&re_i) {
                 continue;

@@ -15,7 +15,7 @@
 //! | `load_sensitivity` | `[LOAD_SENSITIVITY]` FZ1..3 (knot loads from the fit half), MU_FZ1..3, K_FZ1..3 (natural splines of friction and slip stiffness over the load) | LM on a subsample (static) |
 //! | `pressure` | PPX1, PPX3 (with Fx data), PPY1, PPY3 (with Fy/Mz data), PPZ1 (with Mz data) (MF 6.x only: MF 5.2/PAC2002 have no pressure terms; needs a recorded pressure that varies beyond its noise, [`crate::diagnose::factor`]) | LM, static |
 //! | `speed_friction` | `[SPEED_FRICTION]` DMU, VC, VREF (s = g(Vs)/g(σ·VREF), g(v) = 1 − DMU·x/(1 + x), x = v/VC) | LM from two starts, static |
-//! | `rolling_radius` | Q_RE0, FREFF (Re(Fz)); κ re-derived as (1+κ)·Re/Re_baseline − 1 | LM, static |
+//! | `rolling_radius` | Q_RE0, DREFF, FREFF (Re(Fz)); κ re-derived as (1+κ)·Re/Re_baseline − 1 | LM, static |
 //! | `camber` | PDY3, PKY6, PKY7 (PKY3, PHY3 for MF 5.2/PAC2002), PVY3, QHZ3, QDZ8, QDZ9 | LM, static |
 //!
 //! LM = the crate's one Levenberg–Marquardt ([`crate::fit::lm`], bounded by

@@ -36,7 +36,12 @@ struct Model {
 /// κ' = (1 + κ)·Re(tyre)/Re(base) − 1, i.e. the slip the tyre sees at the
 /// recorded wheel speed Ω = (1 + κ)·Vx/Re(base) when the recording's κ was
 /// derived with the baseline's radius (what the FMU does from velocities).
-fn rerolled(rec: &Recording, base: &Tyre, tyre: &Tyre, opts: &ReplayOptions) -> Recording {
+pub(crate) fn rerolled(
+    rec: &Recording,
+    base: &Tyre,
+    tyre: &Tyre,
+    opts: &ReplayOptions,
+) -> Recording {
     let mut out = rec.clone();
     for s in &mut out.samples {
         if !(s.fz.is_finite() && s.vx.is_finite() && s.kappa.is_finite()) {

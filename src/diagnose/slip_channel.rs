@@ -1,0 +1,446 @@
+//! slip_channel — whether the recorded slip ratio was computed with the
+//! tyre's own effective rolling radius: the `rolling_radius` finding that the
+//! forces alone cannot make.
+//!
+//! A rig reports its slip ratio as SR = Ω·R/V − 1 with some radius R of its
+//! own (a constant, the loaded radius, a nominal Re(Fz)). The tyre's
+//! effective rolling radius is what the wheel shows when nothing drives it:
+//! Re = V/Ω at free rolling (Pacejka, *Tire and Vehicle Dynamics*, 3rd ed.,
+//! §2.2 and §9.2.1). On the pure lateral sweeps (no drive or brake torque),
+//! at |α| < 1°, SR therefore reads Re_R/Re − 1 ≈ (R − Re)/Re: constant over
+//! the loads when R follows the tyre's radius (a constant offset is a zero
+//! error of the rig), and varying with load when it does not.
+//!
+//! Read as slip by a model, that load-dependent SR is a longitudinal force
+//! error of K_x(Fz)·ΔSR (K_x the slip stiffness). A Magic Formula fit hides
+//! most of it in its horizontal shift S_Hx = PHX1 + PHX2·dfz (Pacejka eq.
+//! 4.E17): a slip offset and a radius error are the same to the forces, so
+//! no force residual names it; the two radius measurements do.
+//!
+//! The finding ([`check`]): per load level of the free-rolling samples, the
+//! median SR and the median V/Ω; found when the load-dependent part of SR,
+//! weighted by the baseline tyre's own K_x/Fz at that load, exceeds
+//! [`FORCE_SHARE`] at some level. The extension ([`SlipChannel::extended`]):
+//! the effective-rolling-radius keys (Q_RE0, DREFF, FREFF) fitted to the
+//! free-rolling V/Ω, and PHX1, PHX2 re-centred by the slip the new radius
+//! takes away, so that the FMU fed the wheel speed gives the slip the tyre
+//! sees and the forces the fit found.
+//!
+//! Must never: use samples under drive or brake torque (only pure lateral
+//! sweeps), judge a recording with fewer than [`MIN_LEVELS`] load levels, or
+//! call a constant SR offset a radius.
+
+use crate::data::{Recording, SegmentKind};
+use crate::error::Result;
+use crate::mf::{MfInput, Tyre, UseMode};
+use serde::Serialize;
+
+/// Largest load-dependent slip-channel error, in longitudinal force per
+/// load (K_x·|SR − mean SR|/Fz at some level), that is not a finding: 5 % of
+/// Fz is the size of effect the residual candidates must show to be named
+/// ([`crate::diagnose::candidate::MIN_GAIN`] is 5 % of the squared error;
+/// this is the force itself, the stricter reading), and ten times the
+/// quantisation of a four-decimal SR channel at K_x = 20·Fz.
+pub const FORCE_SHARE: f64 = 0.05;
+/// Fewest load levels: two levels cannot tell a load law from an offset.
+pub const MIN_LEVELS: usize = 3;
+/// Fewest free-rolling samples per load level.
+const MIN_SAMPLES: usize = 50;
+
+/// One load level of the free-rolling samples.
+#[derive(Clone, Debug, Serialize)]
+pub struct Level {
+    /// Median load (N).
+    pub fz: f64,
+    /// Samples.
+    pub n: usize,
+    /// Median recorded slip ratio.
+    pub sr: f64,
+    /// Median V/Ω: the tyre's effective rolling radius (m).
+    pub re_free: f64,
+    /// The radius SR was computed with, V·(1 + SR)/Ω (m).
+    pub re_slip: f64,
+    /// The baseline's longitudinal slip stiffness at this load (N).
+    pub kx: f64,
+    /// K_x·|SR − mean SR|/Fz.
+    pub force_share: f64,
+    #[serde(skip)]
+    vx: f64,
+    #[serde(skip)]
+    omega: f64,
+    #[serde(skip)]
+    p: f64,
+    #[serde(skip)]
+    gamma: f64,
+}
+
+/// The slip channel against the free-rolling radius (see the module docs).
+#[derive(Clone, Debug, Serialize)]
+pub struct SlipChannel {
+    pub levels: Vec<Level>,
+    /// Largest minus smallest level SR.
+    pub sr_span: f64,
+    /// Largest [`Level::force_share`].
+    pub force_share: f64,
+    /// Whether this is a finding ([`FORCE_SHARE`]).
+    pub found: bool,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    if v.is_empty() {
+        f64::NAN
+    } else {
+        v[v.len() / 2]
+    }
+}
+
+/// Compare the recorded slip ratio with the free-rolling radius; None when
+/// the recording has no SR channel, no wheel speed, or fewer than
+/// [`MIN_LEVELS`] load levels of free rolling.
+pub fn check(rec: &Recording, tyre: &Tyre) -> Option<SlipChannel> {
+    let sr = rec.extra("SR")?;
+    if !rec.has("omega") {
+        return None;
+    }
+    let fmax = rec
+        .samples
+        .iter()
+        .filter(|s| s.fz.is_finite())
+        .map(|s| s.fz)
+        .fold(0.0, f64::max);
+    let lim = 1f64.to_radians();
+    // Load levels by the segments' load set points (within 5 % of the
+    // largest load), then (fz, sr, V/Ω, vx, Ω, p, γ) of their free-rolling
+    // samples.
+    let mut groups: Vec<(f64, Vec<[f64; 7]>)> = Vec::new();
+    for g in rec
+        .segments
+        .iter()
+        .filter(|g| g.kind == SegmentKind::PureLateral && g.fz.is_finite())
+    {
+        let k = match groups
+            .iter()
+            .position(|(f, _)| (f - g.fz).abs() < 0.05 * fmax)
+        {
+            Some(k) => k,
+            None => {
+                groups.push((g.fz, Vec::new()));
+                groups.len() - 1
+            }
+        };
+        for i in g.start..g.end.min(rec.samples.len()) {
+            let s = &rec.samples[i];
+            let r = sr.get(i).copied().unwrap_or(f64::NAN);
+            if s.alpha.abs() < lim
+                && s.fz > 0.1 * fmax
+                && s.omega > 1.0
+                && s.vx > 1.0
+                && r.is_finite()
+                && r.abs() < 0.1
+            {
+                groups[k]
+                    .1
+                    .push([s.fz, r, s.vx / s.omega, s.vx, s.omega, s.p, s.gamma]);
+            }
+        }
+    }
+    groups.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let groups: Vec<Vec<[f64; 7]>> = groups.into_iter().map(|(_, v)| v).collect();
+    let col = |g: &[[f64; 7]], k: usize| median(g.iter().map(|x| x[k]).collect());
+    let mut levels: Vec<Level> = groups
+        .iter()
+        .filter(|g| g.len() >= MIN_SAMPLES)
+        .map(|g| {
+            let (fz, srm, re, vx, om) = (col(g, 0), col(g, 1), col(g, 2), col(g, 3), col(g, 4));
+            let (p, gamma) = (col(g, 5), col(g, 6));
+            let fx = |k: f64| {
+                tyre.evaluate(
+                    &MfInput {
+                        fz,
+                        kappa: k,
+                        alpha: 0.0,
+                        gamma: if gamma.is_finite() { gamma } else { 0.0 },
+                        phit: 0.0,
+                        vx,
+                        p: if p.is_finite() { p } else { 0.0 },
+                        omega: om,
+                    },
+                    UseMode::default(),
+                )
+                .fx
+            };
+            let kx = (fx(0.002) - fx(-0.002)) / 0.004;
+            Level {
+                fz,
+                n: g.len(),
+                sr: srm,
+                re_free: re,
+                re_slip: re * (1.0 + srm),
+                kx,
+                force_share: f64::NAN,
+                vx,
+                omega: om,
+                p,
+                gamma,
+            }
+        })
+        .collect();
+    if levels.len() < MIN_LEVELS || levels.iter().any(|l| !l.kx.is_finite()) {
+        return None;
+    }
+    let mean = levels.iter().map(|l| l.sr).sum::<f64>() / levels.len() as f64;
+    for l in &mut levels {
+        l.force_share = (l.kx * (l.sr - mean) / l.fz).abs();
+    }
+    let share = levels.iter().map(|l| l.force_share).fold(0.0, f64::max);
+    let (lo, hi) = levels
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, l| {
+            (a.0.min(l.sr), a.1.max(l.sr))
+        });
+    Some(SlipChannel {
+        levels,
+        sr_span: hi - lo,
+        force_share: share,
+        found: share > FORCE_SHARE,
+    })
+}
+
+impl SlipChannel {
+    /// The effective rolling radius of `t` at a level (m).
+    fn re(t: &Tyre, l: &Level) -> f64 {
+        t.slip_properties(
+            &MfInput {
+                fz: l.fz,
+                kappa: 0.0,
+                alpha: 0.0,
+                gamma: if l.gamma.is_finite() { l.gamma } else { 0.0 },
+                phit: 0.0,
+                vx: l.vx,
+                p: if l.p.is_finite() { l.p } else { 0.0 },
+                omega: l.omega,
+            },
+            UseMode::default(),
+        )
+        .re
+    }
+
+    /// The baseline with the tyre's own Re(Fz) (Q_RE0, DREFF, FREFF fitted
+    /// to the levels' V/Ω; Re is linear in them, so one least-squares step
+    /// on a finite-difference Jacobian is exact) and PHX1, PHX2 re-centred by
+    /// the free-rolling slip the new radius changes (see the module docs).
+    pub fn extended(&self, base: &Tyre) -> Result<Tyre> {
+        let keys: Vec<&str> = ["Q_RE0", "DREFF", "FREFF"]
+            .into_iter()
+            .filter(|k| base.params().get(k).is_some())
+            .collect();
+        let with = |vals: &[f64]| -> Result<Tyre> {
+            let mut p = base.params().clone();
+            for (k, v) in keys.iter().zip(vals) {
+                p.set(k, *v)?;
+            }
+            Tyre::new(p)
+        };
+        let x0: Vec<f64> = keys
+            .iter()
+            .map(|k| base.params().get(k).unwrap_or(0.0))
+            .collect();
+        let r0: Vec<f64> = self.levels.iter().map(|l| Self::re(base, l)).collect();
+        let m = self.levels.len();
+        let mut jac = nalgebra::DMatrix::<f64>::zeros(m, keys.len());
+        for j in 0..keys.len() {
+            let mut x = x0.clone();
+            x[j] += 1e-3;
+            let t = with(&x)?;
+            for (i, l) in self.levels.iter().enumerate() {
+                jac[(i, j)] = (Self::re(&t, l) - r0[i]) / 1e-3;
+            }
+        }
+        let y = nalgebra::DVector::from_iterator(
+            m,
+            self.levels.iter().zip(&r0).map(|(l, r)| l.re_free - r),
+        );
+        // Columns that do not act (DREFF with BREFF = 0) are dropped by the
+        // SVD's tolerance.
+        let step = jac
+            .svd(true, true)
+            .solve(&y, 1e-12)
+            .map_err(|e| crate::Error::Other(format!("rolling radius fit: {e}")))?;
+        let x: Vec<f64> = x0.iter().zip(step.iter()).map(|(a, d)| a + d).collect();
+        let mut t = with(&x)?;
+        // Re-centre the horizontal shift of Fx: at free rolling the FMU's κ
+        // changes by Δ = Re_base/V·Ω − Re_new/V·Ω; S_Hx takes it back.
+        let p = t.params();
+        let fz0 = p.p.fnomin * p.get("LFZO").unwrap_or(1.0);
+        let lhx = p.get("LHX").unwrap_or(1.0);
+        if fz0 > 0.0 && lhx != 0.0 {
+            let (mut xs, mut ds) = (Vec::new(), Vec::new());
+            for (l, rb) in self.levels.iter().zip(&r0) {
+                xs.push((l.fz - fz0) / fz0);
+                ds.push((rb - Self::re(&t, l)) / l.re_free);
+            }
+            if let Some((c0, c1)) = crate::data::slip::fit_line(&xs, &ds) {
+                let mut q = t.params().clone();
+                let (h1, h2) = (q.get("PHX1").unwrap_or(0.0), q.get("PHX2").unwrap_or(0.0));
+                q.set("PHX1", h1 + c0 / lhx)?;
+                q.set("PHX2", h2 + c1 / lhx)?;
+                t = Tyre::new(q)?;
+            }
+        }
+        Ok(t)
+    }
+
+    /// The finding in words, with the figures a tyre engineer checks.
+    pub fn words(&self, base: &Tyre, ext: &Tyre) -> String {
+        let (first, last) = (&self.levels[0], &self.levels[self.levels.len() - 1]);
+        let worst = self
+            .levels
+            .iter()
+            .max_by(|a, b| a.force_share.total_cmp(&b.force_share))
+            .unwrap_or(first);
+        let g = |t: &Tyre, k: &str| t.params().get(k).unwrap_or(f64::NAN);
+        format!(
+            "rolling_radius: the recorded slip ratio SR was computed with a rolling radius that is not the tyre's. At free rolling (pure lateral sweeps, |α| < 1°) SR reads {:+.2} % at {:.2} kN and {:+.2} % at {:.2} kN, while the wheel's own effective radius V/Ω goes from {:.1} to {:.1} mm and the radius SR assumes from {:.1} to {:.1} mm. Read as slip, that is a load-dependent Fx of up to {:.0} % of Fz (K_x·ΔSR at {:.2} kN); the baseline absorbed it in its horizontal shift of Fx (PHX1 {:.4}, PHX2 {:.4}: a slip offset and a radius are the same to the forces). The extended file carries the tyre's own Re(Fz) (Q_RE0 {:.4} → {:.4}, DREFF {:.3} → {:.3}, FREFF {:.3} → {:.3}) with PHX1 {:.4}, PHX2 {:.4}, so the FMU fed the wheel speed gives the slip the tyre sees.",
+            100.0 * first.sr,
+            first.fz / 1e3,
+            100.0 * last.sr,
+            last.fz / 1e3,
+            1e3 * first.re_free,
+            1e3 * last.re_free,
+            1e3 * first.re_slip,
+            1e3 * last.re_slip,
+            100.0 * self.force_share,
+            worst.fz / 1e3,
+            g(base, "PHX1"),
+            g(base, "PHX2"),
+            g(base, "Q_RE0"),
+            g(ext, "Q_RE0"),
+            g(base, "DREFF"),
+            g(ext, "DREFF"),
+            g(base, "FREFF"),
+            g(ext, "FREFF"),
+            g(ext, "PHX1"),
+            g(ext, "PHX2"),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::{Sample, Segment};
+    use crate::tir::TyreParams;
+
+    /// Pure lateral sweeps at `loads`, 200 samples each around α = 0, the
+    /// wheel rolling freely at the radius `re(Fz)`, SR computed by the rig
+    /// with the radius `r_rig(Fz)`.
+    fn rig(loads: &[f64], re: impl Fn(f64) -> f64, r_rig: impl Fn(f64) -> f64) -> Recording {
+        let (mut samples, mut sr, mut segments) = (Vec::new(), Vec::new(), Vec::new());
+        let v = 11.0;
+        for &fz in loads {
+            let start = samples.len();
+            for k in 0..200 {
+                let alpha = (k as f64 / 200.0 - 0.5).to_radians();
+                let omega = v / re(fz);
+                samples.push(Sample {
+                    time: samples.len() as f64 * 0.01,
+                    vx: v,
+                    omega,
+                    fz,
+                    alpha,
+                    p: 2.2e5,
+                    ..Default::default()
+                });
+                sr.push(omega * r_rig(fz) / v - 1.0);
+            }
+            segments.push(Segment {
+                start,
+                end: samples.len(),
+                kind: SegmentKind::PureLateral,
+                fz,
+                gamma: 0.0,
+                p: 2.2e5,
+                vx: v,
+                alpha: 0.0,
+            });
+        }
+        let n = samples.len();
+        Recording {
+            source: "test".into(),
+            samples,
+            channels: ["time", "Vx", "omega", "Fz", "alpha", "P", "Fy"]
+                .map(String::from)
+                .to_vec(),
+            extra: vec![("SR".into(), sr)],
+            segments,
+            sweep_dir: vec![0; n],
+            t_in_segment: vec![0.0; n],
+        }
+    }
+
+    fn tyre() -> Tyre {
+        Tyre::new(TyreParams::builtin()).unwrap()
+    }
+
+    /// SR from a constant radius while the tyre's radius falls 2 mm per kN:
+    /// a finding, and the extension gives the tyre's radius (within 0.05 mm
+    /// at every level: Re is linear in the fitted keys) and, at free
+    /// rolling, the same Fx as the baseline fed its own slip (within 3 % of
+    /// Fz: S_Hx is linear in dfz, the baseline's Re is not quite).
+    #[test]
+    fn a_constant_rig_radius_is_a_finding() {
+        let re = |fz: f64| 0.31 - 2e-6 * fz;
+        let rec = rig(&[1000.0, 3000.0, 5000.0], re, |_| 0.304);
+        let t = tyre();
+        let c = check(&rec, &t).unwrap();
+        assert_eq!(c.levels.len(), 3);
+        assert!((c.sr_span - (0.304 / 0.300 - 0.304 / 0.308)).abs() < 1e-9);
+        assert!(c.found, "share {}", c.force_share);
+        let e = c.extended(&t).unwrap();
+        for l in &c.levels {
+            assert!((SlipChannel::re(&e, l) - re(l.fz)).abs() < 5e-5);
+            let fx = |t: &Tyre| {
+                let k = SlipChannel::re(t, l) / l.re_free - 1.0;
+                t.evaluate(
+                    &MfInput {
+                        fz: l.fz,
+                        kappa: k,
+                        vx: l.vx,
+                        p: l.p,
+                        omega: l.omega,
+                        ..Default::default()
+                    },
+                    UseMode::default(),
+                )
+                .fx
+            };
+            assert!(
+                (fx(&e) - fx(&t)).abs() < 0.03 * l.fz,
+                "Fz {}: {} vs {}",
+                l.fz,
+                fx(&e),
+                fx(&t)
+            );
+        }
+        assert!(c.words(&t, &e).contains("rolling_radius"));
+    }
+
+    /// SR computed with the tyre's own radius, plus a constant rig offset:
+    /// no finding.
+    #[test]
+    fn the_tyres_own_radius_with_an_offset_is_not() {
+        let re = |fz: f64| 0.31 - 2e-6 * fz;
+        let rec = rig(&[1000.0, 3000.0, 5000.0], re, |fz| re(fz) * 0.996);
+        let c = check(&rec, &tyre()).unwrap();
+        assert!(c.sr_span < 1e-9);
+        assert!(!c.found && c.force_share < 1e-6, "{}", c.force_share);
+    }
+
+    /// Two load levels cannot tell a load law from an offset.
+    #[test]
+    fn two_levels_are_not_judged() {
+        let rec = rig(&[1000.0, 5000.0], |fz| 0.31 - 2e-6 * fz, |_| 0.304);
+        assert!(check(&rec, &tyre()).is_none());
+    }
+}

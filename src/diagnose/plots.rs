@@ -17,6 +17,12 @@
 //!   relative force scale error against the segment's mean recorded
 //!   pressure (kPa), baseline and extended: the verdict's own evidence.
 //!
+//! * `slip_channel.svg` (when the recorded slip ratio disagrees with the
+//!   free-rolling radius, [`super::slip_channel`]) — per load level the
+//!   wheel's own V/Ω, the radius SR was computed with and the baseline's and
+//!   extended file's Re(Fz) in mm; beside it the free-rolling SR read as a
+//!   force, K_x·(SR − mean SR)/Fz in % of Fz: the `rolling_radius` evidence.
+//!
 //! Must never: draw more than a few thousand points per series (strided),
 //! or fail on a channel the recording lacks (it is skipped).
 
@@ -257,8 +263,94 @@ pub fn draw_all(rec: &Recording, d: &Diagnosis, dir: &Path) -> Result<Vec<Plot>>
             evidence.push(residual_pressure(&c, &d.verdict, dir)?);
         }
     }
+    if let Some(sc) = d.report.slip_channel.as_ref().filter(|s| s.found) {
+        evidence.insert(0, slip_channel(sc, dir)?);
+    }
     evidence.extend(out);
     Ok(evidence)
+}
+
+/// The rolling-radius evidence from the data channels (see the module docs).
+fn slip_channel(sc: &super::slip_channel::SlipChannel, dir: &Path) -> Result<Plot> {
+    let file = "slip_channel.svg".to_string();
+    let path = dir.join(&file);
+    let kn = |f: &dyn Fn(&super::slip_channel::Level) -> f64| -> Vec<(f64, f64)> {
+        sc.levels
+            .iter()
+            .map(|l| (l.fz / 1e3, f(l)))
+            .filter(|p| p.1.is_finite())
+            .collect()
+    };
+    let own = kn(&|l| 1e3 * l.re_free);
+    let mean = sc.levels.iter().map(|l| l.sr).sum::<f64>() / sc.levels.len().max(1) as f64;
+    let share = kn(&|l| 100.0 * l.kx * (l.sr - mean) / l.fz);
+    let bound = 100.0 * super::slip_channel::FORCE_SHARE;
+    let (x0, x1) = (
+        own.first().map_or(0.0, |p| p.0),
+        own.last().map_or(1.0, |p| p.0),
+    );
+    figure(&path, 2, &|a| {
+        panel(
+            &a[0],
+            &path,
+            "free-rolling radius against load",
+            "Fz [kN]",
+            "radius [mm]",
+            &[
+                Series::Points(
+                    own.clone(),
+                    GREY,
+                    "V/Omega at free rolling (the tyre's)".into(),
+                    4,
+                ),
+                Series::Line(
+                    kn(&|l| 1e3 * l.re_slip),
+                    RGBColor(44, 160, 44),
+                    2,
+                    "radius SR was computed with".into(),
+                ),
+                Series::Line(
+                    kn(&|l| 1e3 * l.re_base),
+                    BASE,
+                    2,
+                    "baseline file Re(Fz)".into(),
+                ),
+                Series::Line(
+                    kn(&|l| 1e3 * l.re_extended),
+                    EXT,
+                    2,
+                    "extended file Re(Fz)".into(),
+                ),
+            ],
+            None,
+        )?;
+        panel(
+            &a[1],
+            &path,
+            "free-rolling SR read as slip: Kx (SR - mean)/Fz",
+            "Fz [kN]",
+            "Fx [% of Fz]",
+            &[
+                Series::Points(share.clone(), EXT, "per load level".into(), 4),
+                Series::Line(
+                    vec![(x0, bound), (x1, bound)],
+                    GREY,
+                    1,
+                    "finding bound (5 %)".into(),
+                ),
+                Series::Line(vec![(x0, -bound), (x1, -bound)], GREY, 1, String::new()),
+            ],
+            None,
+        )
+    })?;
+    Ok(Plot {
+        file,
+        channel: "FX",
+        caption: format!(
+            "Rolling radius from the data channels: at free rolling the wheel's own radius V/Ω (grey) and the radius the recorded slip ratio SR assumes (green) part with load; read as slip, SR would give Fx up to {:.0} % of Fz (right; the finding bound is 5 %). The extended file's Re(Fz) (red) follows the tyre's radius, the baseline's (blue) the slip channel's.",
+            100.0 * sc.force_share
+        ),
+    })
 }
 
 fn after_label(verdict: &str) -> String {

@@ -655,11 +655,14 @@ pub fn diagnose_with(
     // finding the force residuals cannot make (see [`slip_channel`]). It
     // names the verdict when no force candidate qualifies, and is added to
     // the explanation otherwise.
-    let slip = slip_channel::check(rec, tyre);
+    let mut slip = slip_channel::check(rec, tyre);
     let slip_ext = match slip.as_ref().filter(|s| s.found) {
         Some(s) => Some(s.extended(tyre)?),
         None => None,
     };
+    if let (Some(s), Some(t)) = (slip.as_mut(), slip_ext.as_ref()) {
+        s.set_extended(t);
+    }
     let slip_words = slip
         .as_ref()
         .zip(slip_ext.as_ref())

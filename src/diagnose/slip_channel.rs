@@ -60,6 +60,10 @@ pub struct Level {
     pub re_free: f64,
     /// The radius SR was computed with, V·(1 + SR)/Ω (m).
     pub re_slip: f64,
+    /// The baseline file's Re at this level (m): the FMU's radius.
+    pub re_base: f64,
+    /// The extended file's Re (m; NaN until [`SlipChannel::set_extended`]).
+    pub re_extended: f64,
     /// The baseline's longitudinal slip stiffness at this load (N).
     pub kx: f64,
     /// K_x·|SR − mean SR|/Fz.
@@ -177,6 +181,8 @@ pub fn check(rec: &Recording, tyre: &Tyre) -> Option<SlipChannel> {
                 sr: srm,
                 re_free: re,
                 re_slip: re * (1.0 + srm),
+                re_base: f64::NAN,
+                re_extended: f64::NAN,
                 kx,
                 force_share: f64::NAN,
                 vx,
@@ -191,6 +197,7 @@ pub fn check(rec: &Recording, tyre: &Tyre) -> Option<SlipChannel> {
     }
     let mean = levels.iter().map(|l| l.sr).sum::<f64>() / levels.len() as f64;
     for l in &mut levels {
+        l.re_base = SlipChannel::re(tyre, l);
         l.force_share = (l.kx * (l.sr - mean) / l.fz).abs();
     }
     let share = levels.iter().map(|l| l.force_share).fold(0.0, f64::max);
@@ -208,6 +215,14 @@ pub fn check(rec: &Recording, tyre: &Tyre) -> Option<SlipChannel> {
 }
 
 impl SlipChannel {
+    /// Record the extended file's Re at every level (for the report).
+    pub fn set_extended(&mut self, ext: &Tyre) {
+        for k in 0..self.levels.len() {
+            let r = Self::re(ext, &self.levels[k]);
+            self.levels[k].re_extended = r;
+        }
+    }
+
     /// The effective rolling radius of `t` at a level (m).
     fn re(t: &Tyre, l: &Level) -> f64 {
         t.slip_properties(
@@ -227,16 +242,20 @@ impl SlipChannel {
     }
 
     /// The baseline with the tyre's own Re(Fz) (Q_RE0, DREFF, FREFF fitted
-    /// to the levels' V/Ω; Re is linear in them, so one least-squares step
-    /// on a finite-difference Jacobian is exact) and PHX1, PHX2 re-centred by
+    /// to the levels' V/Ω for each BREFF of a grid; Re is linear in them, so
+    /// one least-squares step on a finite-difference Jacobian is exact; the
+    /// BREFF of least error kept) and PHX1, PHX2 re-centred by
     /// the free-rolling slip the new radius changes (see the module docs).
     pub fn extended(&self, base: &Tyre) -> Result<Tyre> {
         let keys: Vec<&str> = ["Q_RE0", "DREFF", "FREFF"]
             .into_iter()
             .filter(|k| base.params().get(k).is_some())
             .collect();
-        let with = |vals: &[f64]| -> Result<Tyre> {
+        let with = |breff: f64, vals: &[f64]| -> Result<Tyre> {
             let mut p = base.params().clone();
+            if p.get("BREFF").is_some() {
+                p.set("BREFF", breff)?;
+            }
             for (k, v) in keys.iter().zip(vals) {
                 p.set(k, *v)?;
             }
@@ -246,29 +265,49 @@ impl SlipChannel {
             .iter()
             .map(|k| base.params().get(k).unwrap_or(0.0))
             .collect();
-        let r0: Vec<f64> = self.levels.iter().map(|l| Self::re(base, l)).collect();
         let m = self.levels.len();
-        let mut jac = nalgebra::DMatrix::<f64>::zeros(m, keys.len());
-        for j in 0..keys.len() {
-            let mut x = x0.clone();
-            x[j] += 1e-3;
-            let t = with(&x)?;
-            for (i, l) in self.levels.iter().enumerate() {
-                jac[(i, j)] = (Self::re(&t, l) - r0[i]) / 1e-3;
+        // BREFF (the saturation load of DREFF's term) on a grid, the file's
+        // own first; Q_RE0, DREFF, FREFF by least squares at each.
+        let b0 = base.params().get("BREFF").unwrap_or(0.0);
+        let mut best: Option<(f64, Tyre)> = None;
+        for breff in [b0, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0] {
+            let t0 = with(breff, &x0)?;
+            let r0: Vec<f64> = self.levels.iter().map(|l| Self::re(&t0, l)).collect();
+            let mut jac = nalgebra::DMatrix::<f64>::zeros(m, keys.len());
+            for j in 0..keys.len() {
+                let mut x = x0.clone();
+                x[j] += 1e-3;
+                let t = with(breff, &x)?;
+                for (i, l) in self.levels.iter().enumerate() {
+                    jac[(i, j)] = (Self::re(&t, l) - r0[i]) / 1e-3;
+                }
+            }
+            let y = nalgebra::DVector::from_iterator(
+                m,
+                self.levels.iter().zip(&r0).map(|(l, r)| l.re_free - r),
+            );
+            // Columns that do not act (DREFF with BREFF = 0) are dropped by
+            // the SVD's tolerance.
+            let Ok(step) = jac.svd(true, true).solve(&y, 1e-12) else {
+                continue;
+            };
+            let x: Vec<f64> = x0.iter().zip(step.iter()).map(|(a, d)| a + d).collect();
+            let t = with(breff, &x)?;
+            let sse: f64 = self
+                .levels
+                .iter()
+                .map(|l| (Self::re(&t, l) - l.re_free).powi(2))
+                .sum();
+            if sse.is_finite() && best.as_ref().is_none_or(|b| sse < b.0) {
+                best = Some((sse, t));
             }
         }
-        let y = nalgebra::DVector::from_iterator(
-            m,
-            self.levels.iter().zip(&r0).map(|(l, r)| l.re_free - r),
-        );
-        // Columns that do not act (DREFF with BREFF = 0) are dropped by the
-        // SVD's tolerance.
-        let step = jac
-            .svd(true, true)
-            .solve(&y, 1e-12)
-            .map_err(|e| crate::Error::Other(format!("rolling radius fit: {e}")))?;
-        let x: Vec<f64> = x0.iter().zip(step.iter()).map(|(a, d)| a + d).collect();
-        let mut t = with(&x)?;
+        let Some((_, mut t)) = best else {
+            return Err(crate::Error::Other(
+                "rolling radius fit: no least-squares solution".into(),
+            ));
+        };
+        let r0: Vec<f64> = self.levels.iter().map(|l| Self::re(base, l)).collect();
         // Re-centre the horizontal shift of Fx: at free rolling the FMU's κ
         // changes by Δ = Re_base/V·Ω − Re_new/V·Ω; S_Hx takes it back.
         let p = t.params();

@@ -322,8 +322,9 @@ fn fit_re(
 /// The free-rolling longitudinal force (rolling resistance and offsets, as
 /// the spindle measures it at |α| < 0.5° with no drive or brake torque) as
 /// the MF's vertical shift SVx = Fz·(PVX1 + PVX2·dfz) (Pacejka 3rd ed. eq.
-/// 4.E18), PHX1 = PHX2 = 0: the FMU then gives the recorded Fx where the
-/// recording rolls freely. The pure-Fx stage refits them when the data hold
+/// 4.E18), with the horizontal shift SHx = PHX1 + PHX2·dfz (eq. 4.E17) at
+/// minus the slip the recording reports there: the FMU then gives the
+/// recorded Fx where the recording rolls freely. The pure-Fx stage refits them when the data hold
 /// drive/brake sweeps. Returns the number of samples used.
 fn free_rolling_fx(
     tyre: &mut TyreParams,
@@ -332,7 +333,7 @@ fn free_rolling_fx(
 ) -> crate::Result<usize> {
     let lim = 0.5f64.to_radians();
     let fz0 = tyre.p.fnomin * tyre.p.lfzo;
-    let (mut x, mut y) = (Vec::new(), Vec::new());
+    let (mut x, mut y, mut xk, mut k) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for r in recs {
         if !r.has("Fx") {
             continue;
@@ -349,6 +350,10 @@ fn free_rolling_fx(
             {
                 x.push((s.fz - fz0) / fz0);
                 y.push(s.fx / s.fz);
+                if s.kappa.is_finite() {
+                    xk.push((s.fz - fz0) / fz0);
+                    k.push(s.kappa);
+                }
             }
         }
     }
@@ -362,8 +367,17 @@ fn free_rolling_fx(
     let Some((v1, v2)) = crate::data::slip::fit_line(&x, &y) else {
         return Ok(0);
     };
-    for (k, v) in [("PVX1", v1), ("PVX2", v2), ("PHX1", 0.0), ("PHX2", 0.0)] {
-        tyre.set(k, v)?;
+    // The slip the recording reports at free rolling (a rig's SR offset or
+    // rolling-resistance slip) is the origin of the force curve: S_Hx =
+    // −κ_free, so that the file gives SVx there whatever κ the replay feeds.
+    let lhx = if tyre.p.lhx != 0.0 { tyre.p.lhx } else { 1.0 };
+    let (h1, h2) = if k.len() >= 20 {
+        crate::data::slip::fit_line(&xk, &k).map_or((0.0, 0.0), |(a, b)| (-a / lhx, -b / lhx))
+    } else {
+        (0.0, 0.0)
+    };
+    for (key, v) in [("PVX1", v1), ("PVX2", v2), ("PHX1", h1), ("PHX2", h2)] {
+        tyre.set(key, v)?;
     }
     g.fx_free = Some((x.len(), v1, v2));
     Ok(x.len())

@@ -272,6 +272,28 @@ pub(crate) enum StageRun {
 /// their start values unless the combined runs cover two slip angles or more.
 const SLIP_ANGLE_SHAPE: [&str; 6] = ["rcx1", "rex1", "rex2", "rby2", "rby3", "rvy4"];
 
+/// The slip-angle offset of Gxα (SHxα = RHX1, eq. 4.E57): an asymmetry of
+/// the weight between positive and negative slip angles, seen only when the
+/// drive/brake runs cover both signs of α. At slip angles of one sign it is
+/// collinear with RBX1 and RBX2 (one weight curve G(κ) at that angle, three
+/// parameters): the dev set's runs at α = −3° fitted RHX1 ≈ −1.1° and an
+/// RBX1 twice the generating file's, which extrapolated to −6° underpredicts
+/// Fx by 20 %. Held at its start value unless both signs are present.
+const SLIP_ANGLE_ASYMMETRY: &str = "rhx1";
+
+/// Whether the drive/brake samples (|κ| > 0.01) of `conds` hold slip angles
+/// of both signs (each sign ≥ 5 % of them, beyond ±0.5°).
+fn slip_angle_both_signs(conds: &[crate::mf::Conditions]) -> bool {
+    let edge = 0.5f64.to_radians();
+    let (mut n, mut pos, mut neg) = (0usize, 0usize, 0usize);
+    for c in conds.iter().filter(|c| c.kappa.abs() > 0.01) {
+        n += 1;
+        pos += usize::from(c.alpha > edge);
+        neg += usize::from(c.alpha < -edge);
+    }
+    pos * 20 >= n && neg * 20 >= n && n > 0
+}
+
 /// Number of distinct non-zero |α| levels of the drive/brake samples
 /// (|κ| > 0.01) in `conds`: |α| in 0.5° bins, a bin counted when it holds
 /// ≥ 5 % of those samples (a test plan's slip-angle steps are ≥ 1°; the
@@ -325,6 +347,7 @@ pub(crate) fn run_stage(
     // Slip-angle levels of the combined runs, counted before the pure rows
     // join them (see `SLIP_ANGLE_SHAPE`).
     let combined_alpha_levels = slip_angle_levels(&data.conds);
+    let combined_both_signs = slip_angle_both_signs(&data.conds);
     if kind == StageKind::Combined {
         // The combined weights act on the pure rows too (κ and α are
         // never exactly 0 there: Gyκ, SVyκ, Gxα and Mz's s·Fx apply), so
@@ -341,9 +364,12 @@ pub(crate) fn run_stage(
         data.gamma_spread < CAMBER_SPREAD,
         data.p_spread < PRESSURE_SPREAD,
     );
-    if kind == StageKind::Combined && combined_alpha_levels < 2 {
+    if kind == StageKind::Combined {
         for p in params.iter_mut() {
-            if SLIP_ANGLE_SHAPE.contains(&p.name.to_ascii_lowercase().as_str()) {
+            let name = p.name.to_ascii_lowercase();
+            let shape = combined_alpha_levels < 2 && SLIP_ANGLE_SHAPE.contains(&name.as_str());
+            let asym = !combined_both_signs && name == SLIP_ANGLE_ASYMMETRY;
+            if shape || asym {
                 *p = p.clone().fixed();
             }
         }
@@ -527,7 +553,7 @@ pub fn overall_sigma(m: &[ChannelMetric], channel: &str) -> Option<f64> {
 
 #[cfg(test)]
 mod tests {
-    use super::slip_angle_levels;
+    use super::{slip_angle_both_signs, slip_angle_levels};
     use crate::mf::Conditions;
 
     fn runs(levels_deg: &[f64]) -> Vec<Conditions> {
@@ -563,5 +589,20 @@ mod tests {
             .map(|c| Conditions { kappa: 0.0, ..c })
             .collect();
         assert_eq!(slip_angle_levels(&free), 0);
+    }
+
+    #[test]
+    fn slip_angle_signs_decide_whether_the_asymmetry_is_seen() {
+        // SA 0 and −3° (the dev set's plan), or −3 and −6°: one sign, so
+        // RHX1 is held; ±3°: both signs, so it is fitted.
+        assert!(!slip_angle_both_signs(&runs(&[0.0, -3.0])));
+        assert!(!slip_angle_both_signs(&runs(&[-3.0, -6.0])));
+        assert!(slip_angle_both_signs(&runs(&[3.0, -3.0])));
+        // A stray transition (< 5 % of the drive/brake samples) is no
+        // second sign; no drive/brake samples at all is none.
+        let mut c = runs(&[0.0, -3.0]);
+        c.extend(runs(&[3.0]).into_iter().take(5));
+        assert!(!slip_angle_both_signs(&c));
+        assert!(!slip_angle_both_signs(&[]));
     }
 }

@@ -2,7 +2,9 @@
 //! (issue #14 item 3): the combined-slip stage's result is compared, on the
 //! judged rows (held out where `--holdout` keeps some), with the tyre before
 //! it and with the result after the pure stages were re-polished under the
-//! new combined weights; the candidate kept is the best one that does not
+//! new combined weights (scored on every kind of row the stage fits: the
+//! combined ones and both pure kinds, each channel on all of them); the
+//! candidate kept is the best one that does not
 //! raise any pure-slip channel's error (else the best-scoring of all,
 //! the tyre before included).
 //!
@@ -78,8 +80,10 @@ fn errors(
 struct Judged {
     /// Per channel: mean-square error on its pure rows.
     pure: Vec<f64>,
-    /// Σ over channels of Σe²/Σy² on pure and combined rows together: the
-    /// combined stage's own objective on the judged rows.
+    /// Σ over channels of Σe²/Σy² on the combined rows and both kinds of
+    /// pure rows together: the combined stage's own objective on the judged
+    /// rows (its weights act on Fy and Mz of the drive/brake sweeps at α = 0
+    /// too — κ-induced side force SVyκ, Gyκ — and on Fx of the lateral ones).
     score: f64,
 }
 
@@ -90,14 +94,20 @@ fn judge(
     channels: &[Channel],
 ) -> Judged {
     let comb = errors(ctx, tyre, rows, SegmentKind::Combined, channels);
+    let lat = errors(ctx, tyre, rows, SegmentKind::PureLateral, channels);
+    let lon = errors(ctx, tyre, rows, SegmentKind::PureLongitudinal, channels);
     let mut pure = Vec::new();
     let mut score = 0.0;
     for (k, &c) in channels.iter().enumerate() {
-        let p = errors(ctx, tyre, rows, pure_kind(c), &[c])[0];
+        let p = if pure_kind(c) == SegmentKind::PureLongitudinal {
+            lon[k]
+        } else {
+            lat[k]
+        };
         pure.push(p.0);
-        let den = p.1 + comb[k].1;
+        let den = lat[k].1 + lon[k].1 + comb[k].1;
         if den > 0.0 {
-            score += (p.0 + comb[k].0) / den;
+            score += (lat[k].0 + lon[k].0 + comb[k].0) / den;
         }
     }
     Judged { pure, score }

@@ -591,7 +591,7 @@ const CH_NAMES: [(Ch, &str); 15] = [
 fn extra_dim(name: &str) -> Option<Dim> {
     let n = name.to_ascii_lowercase();
     match n.as_str() {
-        "rl" | "re" | "r_l" | "r_e" | "rloaded" | "reff" | "radload" | "radeff" => {
+        "rl" | "re" | "r_l" | "r_e" | "rloaded" | "reff" | "radload" | "radeff" | "re_sr" => {
             Some(Dim::Length)
         }
         "sr" | "sl" | "nfx" | "nfy" => Some(Dim::Ratio),
@@ -902,7 +902,10 @@ pub fn from_raw(raw: RawTable, format: Format, file: &str, opts: &LoadOptions) -
             None
         };
         match computed {
-            Some(how) => {
+            Some(slip::KappaComputed { how, slip_radius }) => {
+                if let Some(r) = slip_radius {
+                    extra.push((slip::SLIP_RADIUS_CHANNEL.to_string(), r));
+                }
                 if has_kappa {
                     report
                         .notes

@@ -4,7 +4,8 @@
 //!
 //! Missing optional inputs read as: κ, γ, φt → 0; pressure → 0 (= the
 //! `.tir`'s INFLPRES); Ω → (1 + κ)·Vx / R0 (the free-rolling wheel speed
-//! at the recorded slip with the unloaded radius). The lateral slip speed
+//! at the recorded slip with the unloaded radius). Where κ follows the rig's
+//! slip ratio, Ω is the wheel speed that slip implies (see [`wheel_input`]). The lateral slip speed
 //! is Vy = tan α·|Vx| (ISO-W, Pacejka 3rd ed. eq. 2.12), so that the
 //! velocities input mode sees the recorded α exactly.
 //!
@@ -44,13 +45,22 @@ pub fn mf_input(s: &Sample) -> MfInput {
 }
 
 /// The transient model's input for one sample (None when a core input is
-/// missing); Ω from the recording or, missing, (1 + κ)·Vx / R0 of `tyre`.
-pub fn wheel_input(tyre: &Tyre, s: &Sample) -> Option<WheelInput> {
+/// missing). Ω: where the loader took κ from the rig's slip ratio, the
+/// wheel speed that slip implies with the rig's radius, (1 + κ)·Vx /
+/// `slip_radius` ([`crate::data::slip::SLIP_RADIUS_CHANNEL`]: the recorded
+/// speeds carry noise the rig's slip does not); else the recorded Ω; else,
+/// missing, (1 + κ)·Vx / R0 of `tyre`.
+pub fn wheel_input(tyre: &Tyre, s: &Sample, slip_radius: Option<f64>) -> Option<WheelInput> {
     if !has_core_inputs(s) {
         return None;
     }
     let m = mf_input(s);
-    let omega = if s.omega.is_finite() {
+    let from_slip = slip_radius
+        .filter(|r| r.is_finite() && *r > 0.0 && s.kappa.is_finite() && s.omega.is_finite())
+        .map(|r| (1.0 + s.kappa) * s.vx / r);
+    let omega = if let Some(w) = from_slip {
+        w
+    } else if s.omega.is_finite() {
         s.omega
     } else {
         let r0 = tyre.params().p.unloaded_radius;

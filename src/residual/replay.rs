@@ -29,6 +29,10 @@
 //! ([`InputMode::Velocities`]): κ = (Ω·Re(Fz) − Vx)/|Vx| with the tyre's
 //! own effective rolling radius (so a rolling-radius finding changes the
 //! replay), α from Vy = tan α·|Vx|; without Ω the slips stay prescribed.
+//! Where the loader took κ from the rig's slip ratio SR, Ω is the wheel
+//! speed that slip implies with the rig's radius, Vx·(1 + SR)/R_SR
+//! ([`crate::data::slip::SLIP_RADIUS_CHANNEL`]), so the replay's κ is
+//! (1 + SR)·Re(Fz)/R_SR − 1: SR where the file's radius is the rig's.
 //!
 //! Must never: allocate per sample beyond the output vectors, or carry a
 //! state across a gap.
@@ -137,6 +141,9 @@ pub fn replay(rec: &Recording, tyre: &Tyre, opts: &ReplayOptions) -> Result<Repl
         runs: Vec::new(),
         skipped: 0,
     };
+    let slip_radius = rec
+        .extra(crate::data::slip::SLIP_RADIUS_CHANNEL)
+        .filter(|r| r.len() == n);
     let mut run_start: Option<usize> = None;
     for (i, s) in rec.samples.iter().enumerate() {
         let dt = if i > 0 { t[i] - t[i - 1] } else { f64::NAN };
@@ -146,7 +153,7 @@ pub fn replay(rec: &Recording, tyre: &Tyre, opts: &ReplayOptions) -> Result<Repl
                 r.runs.push((a, i));
             }
         }
-        let o = wheel_input(tyre, s).and_then(|inp| {
+        let o = wheel_input(tyre, s, slip_radius.map(|r| r[i])).and_then(|inp| {
             if run_start.is_none() {
                 model.reset();
                 let settle = opts.settle_time.max(0.0);

@@ -173,17 +173,21 @@ fn print_table(v: &[Outcome]) {
 /// Median ratio to the answer's baseline per group: the level the fit has
 /// reached must not get worse (a regression guard while the issue's figures
 /// are not all met; the strict test below is the goal). Complete run of
-/// 2026-11-26 21:40 UTC: pure median 1.02 (5 of 60 over 1.15×), all rows
-/// 1.08 (10 of 60 over 1.5×; 25 Nov: 1.04 and 1.12); the bounds leave room
+/// 2026-11-27 01:00 UTC: pure median 1.00 (none of 60 over 1.15×, worst
+/// 1.07), all rows 1.01 (3 of 60 over 1.5×; 26 Nov: 1.02 and 1.08 with 5
+/// and 10 over; 25 Nov: 1.04 and 1.12); the bounds leave room
 /// for another machine's rounding in the multi-start picks, not for a lost
 /// stage.
-const MEDIAN_MAX: [(&str, f64); 2] = [("pure", 1.10), ("all", 1.30)];
+const MEDIAN_MAX: [(&str, f64); 2] = [("pure", 1.05), ("all", 1.10)];
 
-/// No single figure far off: the 25 Nov run's worst was 3.64× (26 Nov: 3.56×; r12 all-row
-/// Fx, the combined weights extrapolated to a held-out slip angle). A lost
-/// geometry once gave 19.6× (r03: the built-in radius kept, κ ≈ 0.5 in the
-/// velocity-input replay) with the medians still inside their bounds.
-const ANY_MAX: f64 = 4.0;
+/// No single figure far off: the 26 Nov runs' worst was 3.56× (r12 all-row
+/// Fx: the combined weight's slip-angle offset RHX1, fitted at one slip
+/// angle, extrapolated to a held-out angle); with RHX1 held where the
+/// drive/brake runs cover one sign of α the worst is 2.61× (27 Nov: r18
+/// all-row Fx, the FSAE tyre whose Gxα shape differs from the start file's).
+/// A lost geometry once gave 19.6× (r03: the built-in radius kept, κ ≈ 0.5
+/// in the velocity-input replay) with the medians still inside their bounds.
+const ANY_MAX: f64 = 3.0;
 
 #[test]
 fn devset_fit_does_not_get_worse() {
@@ -242,7 +246,7 @@ fn devset_rows_match_the_answer_file() {
 
 /// Issue #14's acceptance figures on all 21 recordings.
 #[test]
-#[ignore = "not met yet (run of 2026-11-26 21:40 UTC): pure Fx of r02, r09, r11, r15, r17 (1.16-1.21x); all-row Fx of 10 full/speed programmes (1.52-3.56x)"]
+#[ignore = "not met yet (run of 2026-11-27 01:00 UTC): all 60 pure figures within 1.15x (worst 1.07x); all-row Fx of r04, r14, r18 (2.03-2.61x: the FSAE tyre, combined weight Gxa fitted at -3 deg and judged at -6 deg, its shape held at the start file's)"]
 fn devset_fit_meets_the_issue_figures() {
     let Some(v) = outcomes() else { return };
     let mut fails = Vec::new();

@@ -57,12 +57,13 @@ pub fn report_lines(r: &FitReport) -> Vec<String> {
 }
 
 /// Stamp a fitted tyre: command, inputs with SHA-256, stages, quality,
-/// skipped stages, geometry.
+/// skipped stages, the gated stages' decisions and held terms, geometry.
 pub fn stamp_fit(tyre: &mut TyreParams, inputs: &[PathBuf], fit: &MfFit) -> Result<()> {
     let mut p = Provenance::of_inputs(inputs)?;
     p.lines = report_lines(&fit.report);
     p.lines
         .extend(fit.skipped.iter().map(|s| format!("stage skipped: {s}")));
+    p.lines.extend(fit.decisions.iter().cloned());
     if let Some(g) = &fit.geometry {
         p.lines.extend(g.lines());
     }

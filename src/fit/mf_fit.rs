@@ -294,6 +294,29 @@ fn slip_angle_both_signs(conds: &[crate::mf::Conditions]) -> bool {
     pos * 20 >= n && neg * 20 >= n && n > 0
 }
 
+/// The line `fit` prints (and stamps into the file) when [`run_stage`] held
+/// combined-slip terms of the weights' dependence on α ([`SLIP_ANGLE_SHAPE`],
+/// [`SLIP_ANGLE_ASYMMETRY`]): the combined forces at slip angles the data do
+/// not hold are then the start file's shape, not a fit.
+fn held_shape_note(out: &super::solve::FitOutcome) -> Option<String> {
+    let held: Vec<String> = out
+        .params
+        .iter()
+        .filter(|p| matches!(p.status, super::solve::ParamStatus::Fixed))
+        .filter(|p| {
+            let n = p.name.to_ascii_lowercase();
+            SLIP_ANGLE_SHAPE.contains(&n.as_str()) || n == SLIP_ANGLE_ASYMMETRY
+        })
+        .map(|p| p.name.to_ascii_uppercase())
+        .collect();
+    (!held.is_empty()).then(|| {
+        format!(
+            "combined stage: the drive/brake runs cover one slip-angle level or one sign of the slip angle, which does not determine how the combined-slip weights change with it; {} held at the start file's values, so combined forces at slip angles the data do not hold are that shape extrapolated, not fitted",
+            held.join(", ")
+        )
+    })
+}
+
 /// Number of distinct non-zero |α| levels of the drive/brake samples
 /// (|κ| > 0.01) in `conds`: |α| in 0.5° bins, a bin counted when it holds
 /// ≥ 5 % of those samples (a test plan's slip-angle steps are ≥ 1°; the
@@ -469,6 +492,9 @@ pub fn fit_mf(
         for p in &out.params {
             tyre.set(&p.name, p.value)?;
         }
+        if kind == StageKind::Combined {
+            decisions.extend(held_shape_note(&out));
+        }
         let mut outs = vec![out];
         if kind == StageKind::Combined {
             let pure: Vec<StageKind> = ran
@@ -589,6 +615,41 @@ mod tests {
             .map(|c| Conditions { kappa: 0.0, ..c })
             .collect();
         assert_eq!(slip_angle_levels(&free), 0);
+    }
+
+    #[test]
+    fn held_slip_angle_terms_are_said() {
+        use crate::fit::solve::{FitOutcome, ParamResult, ParamStatus};
+        let r = |name: &str, status: ParamStatus| ParamResult {
+            name: name.into(),
+            start: 1.0,
+            value: 1.0,
+            stderr: None,
+            status,
+        };
+        let mut out = FitOutcome {
+            stage: "combined".into(),
+            theta: vec![1.0; 3],
+            params: vec![
+                r("rbx1", ParamStatus::Fitted),
+                r("rcx1", ParamStatus::Fixed),
+                r("rhx1", ParamStatus::Fixed),
+            ],
+            initial_cost: 1.0,
+            swarm_cost: None,
+            cost: 1.0,
+            residual_variance: 1.0,
+            correlated: Vec::new(),
+            n_residuals: 10,
+            iterations: 1,
+            termination: crate::fit::lm::Termination::Cost,
+        };
+        let note = super::held_shape_note(&out).expect("held terms are said");
+        assert!(note.contains("RCX1, RHX1") && note.contains("extrapolated"));
+        assert!(!note.contains("RBX1"));
+        // Nothing held (two levels, both signs): nothing said.
+        out.params.retain(|p| p.name == "rbx1");
+        assert!(super::held_shape_note(&out).is_none());
     }
 
     #[test]

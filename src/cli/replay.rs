@@ -92,6 +92,9 @@ pub fn run(a: Args) -> Result<()> {
         rp.skipped,
         kind.name(),
         match mode {
+            crate::transient::InputMode::Velocities
+                if rec.extra(crate::data::slip::SLIP_RADIUS_CHANNEL).is_some() =>
+                "κ from the wheel speed the rig's slip ratio SR implies (Vx·(1 + SR)/Re_SR) and the tyre's Re(Fz)",
             crate::transient::InputMode::Velocities =>
                 "κ from the wheel speed and the tyre's Re(Fz)",
             crate::transient::InputMode::Slips => "slips as recorded (no wheel speed)",

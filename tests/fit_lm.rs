@@ -252,3 +252,81 @@ fn steps_into_undefined_region_are_rejected_not_fatal() {
     // and it did try an undefined point on the way (otherwise the test proves nothing)
     assert!(p.seen.borrow().iter().any(|t| t[0] <= 0.0));
 }
+
+/// Rosenbrock's valley under a noise floor: m − 2 residuals the parameters
+/// cannot change (noise). With `dchi2` the LM stops once a step changes χ²
+/// (σ² = 2·cost/m) by less than `dchi2`: what is left to gain must then be a
+/// small fraction of one unit of χ², reached in fewer iterations than
+/// without the rule; `dchi2 = 0` is the default and changes nothing.
+#[test]
+fn dchi2_stops_statistically_negligible_steps() {
+    struct Noisy(Vec<Param>, usize);
+    impl Problem for Noisy {
+        fn params(&self) -> &[Param] {
+            &self.0
+        }
+        fn n_residuals(&self) -> usize {
+            self.1
+        }
+        fn residuals(&self, t: &[f64], r: &mut [f64]) {
+            r[0] = 10.0 * (t[1] - t[0] * t[0]);
+            r[1] = 1.0 - t[0];
+            for (i, x) in r.iter_mut().enumerate().skip(2) {
+                *x = 0.05 * (((i * 7919) % 101) as f64 / 50.0 - 1.0);
+            }
+        }
+        fn jacobian(
+            &self,
+            t: &[f64],
+            cols: &[usize],
+            r: &mut [f64],
+            jac: &mut DMatrixViewMut<f64>,
+        ) {
+            self.residuals(t, r);
+            let full = [[-20.0 * t[0], 10.0], [-1.0, 0.0]];
+            for (k, &c) in cols.iter().enumerate() {
+                for i in 0..self.1 {
+                    jac[(i, k)] = if i < 2 { full[i][c] } else { 0.0 };
+                }
+            }
+        }
+    }
+    let m = 2000;
+    let start = [-1.2, 1.0];
+    let p = Noisy(
+        vec![
+            Param::unbounded("x", start[0]),
+            Param::unbounded("y", start[1]),
+        ],
+        m,
+    );
+    let run = |dchi2: f64| {
+        let o = LmOptions {
+            dchi2,
+            ..LmOptions::default()
+        };
+        lm::minimize(&p, &start, &[true, true], &o, None).unwrap()
+    };
+    let exact = run(0.0);
+    let default = lm::minimize(&p, &start, &[true, true], &LmOptions::default(), None).unwrap();
+    assert_eq!(exact.theta, default.theta);
+    assert_eq!(exact.iterations, default.iterations);
+    // The floor: the noise residuals alone (Rosenbrock's part is 0 at (1, 1)).
+    let floor = exact.cost;
+    assert!((exact.theta[0] - 1.0).abs() < 1e-6, "{:?}", exact.theta);
+    let quick = run(1e-3);
+    let left_chi2 = (quick.cost - floor) * m as f64 / floor;
+    assert!(
+        (0.0..0.01).contains(&left_chi2),
+        "Δχ² left {left_chi2:e} ({:?} after {} iterations)",
+        quick.theta,
+        quick.iterations
+    );
+    assert!(
+        quick.iterations < exact.iterations,
+        "{} vs {}",
+        quick.iterations,
+        exact.iterations
+    );
+    assert_eq!(quick.termination, lm::Termination::Cost);
+}

@@ -22,6 +22,7 @@ pub mod fmi;
 pub mod mf;
 pub mod residual;
 pub mod rig;
+pub(crate) mod stats;
 pub mod tir;
 pub mod transient;
 

@@ -19,6 +19,7 @@
 
 use super::{LoadReport, Sample};
 use crate::error::{Error, Result};
+use crate::stats::median;
 
 /// Plausible radius (m) implied by a wheel speed, V/Ω, and range of a
 /// recorded radius: from a 10-inch kart wheel to an earth-mover tyre.
@@ -86,15 +87,6 @@ fn loaded(s: &Sample, fmax: f64) -> bool {
     s.fz.is_finite() && s.fz.abs() > LOADED_SHARE * fmax
 }
 
-fn median(mut v: Vec<f64>) -> Option<f64> {
-    v.retain(|x| x.is_finite());
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_by(f64::total_cmp);
-    Some(v[v.len() / 2])
-}
-
 /// Wheel speed: on rows rolling faster than 1 m/s the implied radius V/Ω
 /// must lie in [`RADIUS_RANGE`]. A channel failing on most of them (a dead
 /// N ≈ 0 rpm export, a wrong unit) is rejected.
@@ -120,7 +112,7 @@ pub(crate) fn check_wheel_speed(
     // Half the moving rows: a locked wheel (Ω = 0 at κ = −1) is real on a
     // few rows of a brake sweep, never on most of a test.
     if moving > 0 && bad * 2 > moving {
-        let med = median(samples.iter().map(|s| s.omega).collect()).unwrap_or(f64::NAN);
+        let med = median(samples.iter().map(|s| s.omega)).unwrap_or(f64::NAN);
         reject(
             samples,
             channels,
@@ -207,7 +199,7 @@ pub(crate) fn check_pinned_slip(
         return;
     }
     let pinned = |v: &dyn Fn(usize) -> f64| {
-        median(cornering.iter().map(|&i| v(i)).collect()).is_some_and(|m| m < -0.9)
+        median(cornering.iter().map(|&i| v(i))).is_some_and(|m| m < -0.9)
     };
     if channels.iter().any(|c| c == "kappa") && pinned(&|i| samples[i].kappa) {
         reject(
@@ -309,7 +301,7 @@ pub(crate) fn check_conventions(
     // Pressure: a gauge pressure in Pa below 1000 is no tyre's; kPa or bar
     // labelled Pa.
     if has("P") {
-        if let Some(m) = median(samples.iter().map(|s| s.p).collect()) {
+        if let Some(m) = median(samples.iter().map(|s| s.p)) {
             if m > 0.0 && m < 1000.0 {
                 let likely = if m < 20.0 { "bar" } else { "kPa or psi" };
                 return Err(err(

@@ -24,6 +24,7 @@
 //! recordings without the set-point channels (they become one segment).
 
 use super::{LoadReport, Recording, Sample, Segment, SegmentKind};
+use crate::stats::median_in_place;
 
 /// Tolerances used for binning set points.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -74,15 +75,6 @@ pub struct WarmupCut {
     pub reason: String,
 }
 
-fn median(v: &mut [f64]) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    let m = v.len() / 2;
-    v.select_nth_unstable_by(m, |a, b| a.total_cmp(b));
-    v[m]
-}
-
 /// Piecewise-constant smoothing in O(n): every sample gets the median of its
 /// block of `b` samples (NaN-aware). Used for set-point channels, whose
 /// levels only need to be found, not tracked sample by sample.
@@ -93,7 +85,7 @@ fn block_median(x: &[f64], b: usize) -> Vec<f64> {
     for chunk in x.chunks(b) {
         buf.clear();
         buf.extend(chunk.iter().copied().filter(|v| v.is_finite()));
-        let m = median(&mut buf);
+        let m = median_in_place(&mut buf);
         out.extend(std::iter::repeat_n(m, chunk.len()));
     }
     out
@@ -242,7 +234,7 @@ fn pct(x: impl Iterator<Item = f64>, p: f64) -> f64 {
 
 fn med_of(s: &[Sample], f: impl Fn(&Sample) -> f64) -> f64 {
     let mut v: Vec<f64> = s.iter().map(f).filter(|v| v.is_finite()).collect();
-    median(&mut v)
+    median_in_place(&mut v)
 }
 
 /// Segment the samples (no warm-up logic): the segments, in order.
@@ -256,7 +248,7 @@ pub fn segment(samples: &[Sample], o: &SegmentOptions) -> Vec<Segment> {
         .map(|w| w[1].time - w[0].time)
         .filter(|d| *d > 0.0)
         .collect();
-    let dt = median(&mut dts).max(1e-6);
+    let dt = median_in_place(&mut dts).max(1e-6);
     let dt = if dt.is_finite() { dt } else { 0.01 };
     let w = ((0.5 / dt).round() as usize).clamp(1, 201) | 1;
     let min_len = ((o.min_duration / dt).round() as usize).max(3);
@@ -466,7 +458,7 @@ pub fn detect_warmup(s: &[Sample], segs: &[Segment]) -> Option<(usize, String)> 
         }
         let m = |k: usize| {
             let mut v: Vec<f64> = sig.iter().map(|x| [x.0, x.1, x.2][k]).collect();
-            median(&mut v)
+            median_in_place(&mut v)
         };
         Some((m(0), m(1), m(2)))
     };

@@ -43,6 +43,7 @@ use crate::error::Result;
 use crate::fit::mf_fit::{fit_mf, MfFitOptions};
 use crate::fit::mf_stages::{Channel, StageKind};
 use crate::fit::{Holdout, ProgressFn};
+use crate::stats::median;
 use crate::tir::TyreParams;
 
 /// Largest number of samples the baseline fit sees (all recordings together).
@@ -155,16 +156,6 @@ pub fn drop_unfitted(recs: &mut [Recording], b: &Baseline) -> Vec<&'static str> 
     out
 }
 
-/// Median of the finite values of `v` (None when there are none).
-fn median(mut v: Vec<f64>) -> Option<f64> {
-    v.retain(|x| x.is_finite());
-    if v.is_empty() {
-        return None;
-    }
-    let m = v.len() / 2;
-    Some(*v.select_nth_unstable_by(m, f64::total_cmp).1)
-}
-
 /// Widen PRESMIN/PRESMAX to the recorded pressures (±20 %): the replay
 /// runs with the file's range limits on (use mode 111, as the FMU), and a
 /// pressure below PRESMIN would be clipped — the built-in tyre's range
@@ -199,8 +190,7 @@ pub fn fit_baseline(
     let stride = n.div_ceil(MAX_FIT_SAMPLES).max(1);
     let p_med = median(
         recs.iter()
-            .flat_map(|r| r.samples.iter().step_by(10).map(|s| s.p))
-            .collect(),
+            .flat_map(|r| r.samples.iter().step_by(10).map(|s| s.p)),
     );
     let data: Vec<Recording> = recs
         .iter()

@@ -33,6 +33,7 @@
 use crate::data::{Recording, SegmentKind};
 use crate::error::Result;
 use crate::mf::{MfInput, Tyre, UseMode};
+use crate::stats::median;
 use serde::Serialize;
 
 /// Largest load-dependent slip-channel error, in longitudinal force per
@@ -90,15 +91,6 @@ pub struct SlipChannel {
     pub found: bool,
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    if v.is_empty() {
-        f64::NAN
-    } else {
-        v[v.len() / 2]
-    }
-}
-
 /// Compare the recorded slip ratio with the free-rolling radius; None when
 /// the recording has no SR channel, no wheel speed, or fewer than
 /// [`MIN_LEVELS`] load levels of free rolling.
@@ -151,7 +143,7 @@ pub fn check(rec: &Recording, tyre: &Tyre) -> Option<SlipChannel> {
     }
     groups.sort_by(|a, b| a.0.total_cmp(&b.0));
     let groups: Vec<Vec<[f64; 7]>> = groups.into_iter().map(|(_, v)| v).collect();
-    let col = |g: &[[f64; 7]], k: usize| median(g.iter().map(|x| x[k]).collect());
+    let col = |g: &[[f64; 7]], k: usize| median(g.iter().map(|x| x[k])).unwrap_or(f64::NAN);
     let mut levels: Vec<Level> = groups
         .iter()
         .filter(|g| g.len() >= MIN_SAMPLES)

@@ -18,6 +18,7 @@ use super::solve::{FitOptions, ProgressFn};
 use super::validity::Grid;
 use crate::data::{Recording, SegmentKind};
 use crate::mf::{form_of, Model};
+use crate::stats::median;
 use crate::tir::TyreParams;
 use std::ops::Range;
 
@@ -109,15 +110,6 @@ pub struct MfFit {
     pub splits: Vec<TrainTest>,
     /// The geometry fit, when [`MfFitOptions::geometry`] asked for it.
     pub geometry: Option<super::geometry::Geometry>,
-}
-
-fn median(mut v: Vec<f64>) -> Option<f64> {
-    v.retain(|x| x.is_finite());
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_by(|a, b| a.total_cmp(b));
-    Some(v[v.len() / 2])
 }
 
 /// Nominal values from the data: FNOMIN = median of the segments' load set

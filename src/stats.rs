@@ -1,0 +1,44 @@
+//! stats — the order statistics the data, fit and diagnose stages share
+//! (one median, not one per module).
+//!
+//! Must never: panic on empty or non-finite input, or allocate when given a
+//! slice to work in.
+
+/// Median of the finite values of `v`: the upper median (element n/2 in
+/// sorted order: the exact median for odd n, a value the data hold for even
+/// n); None when no value is finite.
+///
+/// ```ignore
+/// assert_eq!(crate::stats::median([3.0, f64::NAN, 1.0, 2.0]), Some(2.0));
+/// ```
+pub(crate) fn median(v: impl IntoIterator<Item = f64>) -> Option<f64> {
+    let mut v: Vec<f64> = v.into_iter().filter(|x| x.is_finite()).collect();
+    let m = median_in_place(&mut v);
+    (!v.is_empty()).then_some(m)
+}
+
+/// Upper median of `v`, reordering it in place (no allocation); NaN when
+/// empty. Non-finite values count as values (NaN after +∞): filter first.
+pub(crate) fn median_in_place(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let m = v.len() / 2;
+    *v.select_nth_unstable_by(m, f64::total_cmp).1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn upper_median_of_the_finite_values() {
+        assert_eq!(median([3.0, f64::NAN, 1.0, 2.0]), Some(2.0));
+        assert_eq!(median([4.0, 1.0, 3.0, 2.0]), Some(3.0));
+        assert_eq!(median([f64::NAN, f64::INFINITY]), None);
+        assert_eq!(median(Vec::new()), None);
+        let mut v = [5.0, -1.0, 2.0];
+        assert_eq!(median_in_place(&mut v), 2.0);
+        assert!(median_in_place(&mut []).is_nan());
+    }
+}

@@ -260,17 +260,17 @@ fn steps_into_undefined_region_are_rejected_not_fatal() {
 /// without the rule; `dchi2 = 0` is the default and changes nothing.
 #[test]
 fn dchi2_stops_statistically_negligible_steps() {
-    struct Noisy(Vec<Param>, usize);
+    /// Rosenbrock's two residuals, then m − 2 constants (the noise floor).
+    struct Noisy(Rosenbrock, usize);
     impl Problem for Noisy {
         fn params(&self) -> &[Param] {
-            &self.0
+            self.0.params()
         }
         fn n_residuals(&self) -> usize {
             self.1
         }
         fn residuals(&self, t: &[f64], r: &mut [f64]) {
-            r[0] = 10.0 * (t[1] - t[0] * t[0]);
-            r[1] = 1.0 - t[0];
+            self.0.residuals(t, &mut r[..2]);
             for (i, x) in r.iter_mut().enumerate().skip(2) {
                 *x = 0.05 * (((i * 7919) % 101) as f64 / 50.0 - 1.0);
             }
@@ -283,21 +283,18 @@ fn dchi2_stops_statistically_negligible_steps() {
             jac: &mut DMatrixViewMut<f64>,
         ) {
             self.residuals(t, r);
-            let full = [[-20.0 * t[0], 10.0], [-1.0, 0.0]];
-            for (k, &c) in cols.iter().enumerate() {
-                for i in 0..self.1 {
-                    jac[(i, k)] = if i < 2 { full[i][c] } else { 0.0 };
-                }
-            }
+            jac.fill(0.0);
+            let mut top = jac.rows_mut(0, 2);
+            self.0.jacobian(t, cols, &mut r[..2], &mut top);
         }
     }
     let m = 2000;
     let start = [-1.2, 1.0];
     let p = Noisy(
-        vec![
+        Rosenbrock(vec![
             Param::unbounded("x", start[0]),
             Param::unbounded("y", start[1]),
-        ],
+        ]),
         m,
     );
     let run = |dchi2: f64| {

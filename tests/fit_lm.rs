@@ -253,6 +253,40 @@ fn steps_into_undefined_region_are_rejected_not_fatal() {
     assert!(p.seen.borrow().iter().any(|t| t[0] <= 0.0));
 }
 
+/// Rosenbrock's two residuals, then m − 2 constants (the noise floor).
+struct Noisy(Rosenbrock, usize);
+impl Problem for Noisy {
+    fn params(&self) -> &[Param] {
+        self.0.params()
+    }
+    fn n_residuals(&self) -> usize {
+        self.1
+    }
+    fn residuals(&self, t: &[f64], r: &mut [f64]) {
+        self.0.residuals(t, &mut r[..2]);
+        for (i, x) in r.iter_mut().enumerate().skip(2) {
+            *x = 0.05 * (((i * 7919) % 101) as f64 / 50.0 - 1.0);
+        }
+    }
+    fn jacobian(&self, t: &[f64], cols: &[usize], r: &mut [f64], jac: &mut DMatrixViewMut<f64>) {
+        self.residuals(t, r);
+        jac.fill(0.0);
+        let mut top = jac.rows_mut(0, 2);
+        self.0.jacobian(t, cols, &mut r[..2], &mut top);
+    }
+}
+
+/// [`Noisy`] Rosenbrock of `m` residuals with unbounded x, y at `start`.
+fn noisy_rosenbrock(m: usize, start: [f64; 2]) -> Noisy {
+    Noisy(
+        Rosenbrock(vec![
+            Param::unbounded("x", start[0]),
+            Param::unbounded("y", start[1]),
+        ]),
+        m,
+    )
+}
+
 /// Rosenbrock's valley under a noise floor: m − 2 residuals the parameters
 /// cannot change (noise). With `dchi2` the LM stops once a step changes χ²
 /// (σ² = 2·cost/m) by less than `dchi2`: what is left to gain must then be a
@@ -260,43 +294,9 @@ fn steps_into_undefined_region_are_rejected_not_fatal() {
 /// without the rule; `dchi2 = 0` is the default and changes nothing.
 #[test]
 fn dchi2_stops_statistically_negligible_steps() {
-    /// Rosenbrock's two residuals, then m − 2 constants (the noise floor).
-    struct Noisy(Rosenbrock, usize);
-    impl Problem for Noisy {
-        fn params(&self) -> &[Param] {
-            self.0.params()
-        }
-        fn n_residuals(&self) -> usize {
-            self.1
-        }
-        fn residuals(&self, t: &[f64], r: &mut [f64]) {
-            self.0.residuals(t, &mut r[..2]);
-            for (i, x) in r.iter_mut().enumerate().skip(2) {
-                *x = 0.05 * (((i * 7919) % 101) as f64 / 50.0 - 1.0);
-            }
-        }
-        fn jacobian(
-            &self,
-            t: &[f64],
-            cols: &[usize],
-            r: &mut [f64],
-            jac: &mut DMatrixViewMut<f64>,
-        ) {
-            self.residuals(t, r);
-            jac.fill(0.0);
-            let mut top = jac.rows_mut(0, 2);
-            self.0.jacobian(t, cols, &mut r[..2], &mut top);
-        }
-    }
     let m = 2000;
     let start = [-1.2, 1.0];
-    let p = Noisy(
-        Rosenbrock(vec![
-            Param::unbounded("x", start[0]),
-            Param::unbounded("y", start[1]),
-        ]),
-        m,
-    );
+    let p = noisy_rosenbrock(m, start);
     let run = |dchi2: f64| {
         let o = LmOptions {
             dchi2,
@@ -326,4 +326,66 @@ fn dchi2_stops_statistically_negligible_steps() {
         exact.iterations
     );
     assert_eq!(quick.termination, lm::Termination::Cost);
+}
+
+/// A descent toward a minimum at infinity under a noise floor: residual
+/// 10·e^(−x) (each Gauss–Newton step moves x by 1 and removes 86 % of what
+/// is left), then m − 1 constants. Every step is accepted and gains less
+/// than the last, so `ftol` (1e-12 of the cost) stops it only after many.
+struct Fading(Vec<Param>, usize);
+
+impl Problem for Fading {
+    fn params(&self) -> &[Param] {
+        &self.0
+    }
+    fn n_residuals(&self) -> usize {
+        self.1
+    }
+    fn residuals(&self, t: &[f64], r: &mut [f64]) {
+        r[0] = 10.0 * (-t[0]).exp();
+        for (i, x) in r.iter_mut().enumerate().skip(1) {
+            *x = 0.05 * (((i * 7919) % 101) as f64 / 50.0 - 1.0);
+        }
+    }
+    fn jacobian(&self, t: &[f64], _: &[usize], r: &mut [f64], jac: &mut DMatrixViewMut<f64>) {
+        self.residuals(t, r);
+        jac.fill(0.0);
+        jac[(0, 0)] = -10.0 * (-t[0]).exp();
+    }
+}
+
+/// The stall rule stops the creeping descent of [`Fading`]: with
+/// `stall = (5, 1e-3)` the LM stops `Stalled` in fewer iterations than
+/// without it, and what is left to gain is below the share the rule
+/// tolerates (1e-3 of the cost: the gains of such a descent shrink, so the
+/// rest is less than the last five steps gained). Without `stall` nothing
+/// changes.
+#[test]
+fn stall_stops_a_creeping_descent() {
+    let p = Fading(vec![Param::unbounded("x", 0.0)], 2000);
+    let run = |stall: Option<(usize, f64)>| {
+        let o = LmOptions {
+            stall,
+            ..LmOptions::default()
+        };
+        lm::minimize(&p, &[0.0], &[true], &o, None).unwrap()
+    };
+    let exact = run(None);
+    let default = lm::minimize(&p, &[0.0], &[true], &LmOptions::default(), None).unwrap();
+    assert_eq!(exact.theta, default.theta);
+    assert_eq!(exact.iterations, default.iterations);
+    let quick = run(Some((5, 1e-3)));
+    assert_eq!(quick.termination, lm::Termination::Stalled);
+    assert!(
+        quick.iterations < exact.iterations,
+        "{} vs {}",
+        quick.iterations,
+        exact.iterations
+    );
+    let left = (quick.cost - exact.cost) / quick.cost;
+    assert!(
+        (0.0..1e-3).contains(&left),
+        "left {left:e} at {:?}",
+        quick.theta
+    );
 }

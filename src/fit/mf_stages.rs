@@ -426,6 +426,15 @@ pub fn fit_stage_from(
     )
 }
 
+/// Most LM iterations per round of one start in [`best_start`]: the starts
+/// race, and the winner is polished to convergence afterwards, so the limit
+/// decides only which start wins when one of them crawls. A start still
+/// descending after 50 Gauss–Newton-like steps on the subsample sits in a
+/// valley far from any minimum the others reached quickly (rig recording of
+/// `tyrekit bench diagnose`, combined stage: the own start took 200
+/// iterations, 40 s, to reach a cost of 90.6; the neutral start 82.7 in 22).
+pub const START_ITERATIONS: usize = 50;
+
 /// Several starts (issue #14 item 3): the problem's own and `extra`, each
 /// converged on the subsample `coarse` (to 1e-6; on the problem itself when
 /// there is none), judged by the full problem's cost — with a subsample
@@ -443,6 +452,7 @@ fn best_start(
     loose.lm.ftol = loose.lm.ftol.max(1e-6);
     loose.lm.xtol = loose.lm.xtol.max(1e-6);
     loose.lm.gtol = loose.lm.gtol.max(1e-6);
+    loose.lm.max_iter = loose.lm.max_iter.min(START_ITERATIONS);
     loose.coarse_first = false;
     let on = coarse.unwrap_or(problem);
     let mut r = vec![0.0; problem.n_residuals()];

@@ -428,11 +428,11 @@ pub fn fit_stage_from(
 
 /// Most LM iterations per round of one start in [`best_start`]: the starts
 /// race, and the winner is polished to convergence afterwards, so the limit
-/// decides only which start wins when one of them crawls. A start still
-/// descending after 50 Gauss–Newton-like steps on the subsample sits in a
-/// valley far from any minimum the others reached quickly (rig recording of
-/// `tyrekit bench diagnose`, combined stage: the own start took 200
-/// iterations, 40 s, to reach a cost of 90.6; the neutral start 82.7 in 22).
+/// decides only which start wins when one of them crawls: a start still
+/// descending after 50 steps on the subsample is then judged where it
+/// stands (rig recording of `tyrekit bench diagnose`, combined stage: the
+/// own start took 200 iterations, 40 s, to reach a cost of 90.6; the
+/// neutral start 82.7 in 22).
 pub const START_ITERATIONS: usize = 50;
 
 /// Several starts (issue #14 item 3): the problem's own and `extra`, each

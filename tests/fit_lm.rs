@@ -253,6 +253,12 @@ fn steps_into_undefined_region_are_rejected_not_fatal() {
     assert!(p.seen.borrow().iter().any(|t| t[0] <= 0.0));
 }
 
+/// Residual `i` of the noise floor shared by the LM stop tests: fixed
+/// values in ±0.05 the parameters cannot change.
+fn noise_floor(i: usize) -> f64 {
+    0.05 * (((i * 7919) % 101) as f64 / 50.0 - 1.0)
+}
+
 /// Rosenbrock's two residuals, then m − 2 constants (the noise floor).
 struct Noisy(Rosenbrock, usize);
 impl Problem for Noisy {
@@ -265,7 +271,7 @@ impl Problem for Noisy {
     fn residuals(&self, t: &[f64], r: &mut [f64]) {
         self.0.residuals(t, &mut r[..2]);
         for (i, x) in r.iter_mut().enumerate().skip(2) {
-            *x = 0.05 * (((i * 7919) % 101) as f64 / 50.0 - 1.0);
+            *x = noise_floor(i);
         }
     }
     fn jacobian(&self, t: &[f64], cols: &[usize], r: &mut [f64], jac: &mut DMatrixViewMut<f64>) {
@@ -344,7 +350,7 @@ impl Problem for Fading {
     fn residuals(&self, t: &[f64], r: &mut [f64]) {
         r[0] = 10.0 * (-t[0]).exp();
         for (i, x) in r.iter_mut().enumerate().skip(1) {
-            *x = 0.05 * (((i * 7919) % 101) as f64 / 50.0 - 1.0);
+            *x = noise_floor(i);
         }
     }
     fn jacobian(&self, t: &[f64], _: &[usize], r: &mut [f64], jac: &mut DMatrixViewMut<f64>) {

@@ -38,10 +38,9 @@ use serde::Serialize;
 
 /// Largest load-dependent slip-channel error, in longitudinal force per
 /// load (K_x·|SR − mean SR|/Fz at some level), that is not a finding: 5 % of
-/// Fz is the size of effect the residual candidates must show to be named
-/// ([`crate::diagnose::candidate::MIN_GAIN`] is 5 % of the squared error;
-/// this is the force itself, the stricter reading), and ten times the
-/// quantisation of a four-decimal SR channel at K_x = 20·Fz.
+/// Fz, a force error no fitted tyre hides (a measured slip stiffness is
+/// good to a few %), and ten times the quantisation of a four-decimal SR
+/// channel at K_x = 20·Fz.
 pub const FORCE_SHARE: f64 = 0.05;
 /// Fewest load levels: two levels cannot tell a load law from an offset.
 pub const MIN_LEVELS: usize = 3;

@@ -61,13 +61,16 @@
 //!   n_eff·ln(SSE ratio) + k·ln(n_eff), n_eff = recorded seconds
 //!   ([`DECORRELATION_TIME`]), k = parameters fitted.
 //! * Verdict ([`select`], [`qualifies`]): a candidate qualifies when some
-//!   channel's held-out error falls by more than [`MIN_GAIN`], none rises by
-//!   more than [`MAX_LOSS`] (physics that is missing makes no channel worse;
-//!   a candidate that trades one channel for another absorbs a misfit), the
-//!   pooled held-out and in-sample gains are positive, and its BIC falls;
-//!   among those the lowest BIC wins, otherwise `none`. The held-out test
-//!   keeps noise and over-fitting out; BIC then prefers the fewer parameters
-//!   between explanations that generalise alike.
+//!   channel's held-out error falls by more than [`MIN_GAIN`] and that
+//!   channel's own BIC falls (an effect may live in one channel), none rises
+//!   by more than [`MAX_LOSS`] (physics that is missing makes no channel
+//!   worse; a candidate that trades one channel for another absorbs a
+//!   misfit), and the pooled held-out and in-sample gains are positive;
+//!   among those the lowest pooled BIC wins, otherwise `none`. The held-out
+//!   test keeps over-fitting out, the channel's BIC asks for evidence in
+//!   proportion to the parameters and the seconds of data, and the pooled
+//!   BIC then prefers the fewer parameters between explanations that
+//!   generalise alike.
 //!
 //! Must never: let a candidate see the held-out segments' forces while
 //! fitting (their inputs may drive a state), or panic on a recording with

@@ -328,7 +328,7 @@ pub const LM_ITERATIONS: usize = 12;
 
 /// Relative cost reduction below which a candidate's fit stops: 10⁻⁵ of
 /// the weighted SSE is far below what any held-out gain of
-/// [`super::MIN_GAIN`] = 5 % needs.
+/// [`super::MIN_GAIN`] = 2 % needs.
 pub const LM_FTOL: f64 = 1e-5;
 
 /// A candidate's least-squares problem for the crate's LM: r(θ) is the

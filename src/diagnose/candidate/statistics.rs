@@ -27,6 +27,11 @@ pub struct ChannelScore {
     pub oos_gain: f64,
     /// The same on the fit half.
     pub fit_gain: f64,
+    /// BIC change of this channel alone over both halves (negative =
+    /// better): n_k·ln(SSE_k/SSE_k,base) + p·ln(n_k), n_k = the channel's
+    /// recorded seconds ([`DECORRELATION_TIME`]), p = all the candidate's
+    /// fitted parameters. See [`evaluate`].
+    pub delta_bic: f64,
 }
 
 /// A candidate's evaluation.
@@ -249,7 +254,14 @@ pub const DECORRELATION_TIME: f64 = 1.0;
 /// removed. The pooled gain over a half is 1 − exp(Σ n_k·ln(SSE_k/SSE_k,base)
 /// / Σ n_k): the log-likelihood ratio of the Gaussian model with one
 /// variance per channel, per sample. ΔBIC = n_eff·ln(1 − gain_all) +
-/// k·ln(n_eff) over both halves, n_eff = duration / [`DECORRELATION_TIME`].
+/// k·ln(n_eff) over both halves, n_eff = duration / [`DECORRELATION_TIME`]:
+/// the recording's seconds counted once for all channels together (Fy and
+/// Mz residuals of one sweep are not independent evidence), so a channel's
+/// gain enters with its share of the samples. Per channel
+/// ([`ChannelScore::delta_bic`]) the same with the channel's own seconds
+/// and SSE ratio: the evidence of an effect that lives in one channel (a
+/// friction law of the sliding speed in the drive/brake sweeps' Fx), which
+/// the pooled figure dilutes by the channels it does not act on.
 pub fn evaluate(
     rec: &Recording,
     baseline: &Tyre,
@@ -316,6 +328,10 @@ pub fn evaluate(
                             n: sb[1][j].1,
                             oos_gain: gain(sb[1][j].0, s[1][j].0),
                             fit_gain: gain(sb[0][j].0, s[0][j].0),
+                            delta_bic: {
+                                let n = (s[2][j].1 as f64 * h / DECORRELATION_TIME).max(2.0);
+                                n * (s[2][j].0 / sb[2][j].0).max(1e-300).ln() + k as f64 * n.ln()
+                            },
                         })
                         .collect();
                     Ok((

@@ -36,6 +36,7 @@ fn camber_spec(t: &Tyre, _: &ReplayOptions) -> Option<Spec> {
             q("QDZ9", 0.005).on(&[MZ]),
         ],
         levels: Some((|g| g.gamma, 0.5f64.to_radians())),
+        eliminate: true,
         ..Spec::default()
     })
 }

@@ -110,6 +110,7 @@ fn load_spec(_: &Tyre, _: &ReplayOptions) -> Option<Spec> {
     Some(Spec {
         params,
         from_data: Some(knots),
+        eliminate: true,
         ..Spec::default()
     })
 }

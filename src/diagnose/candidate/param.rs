@@ -30,6 +30,7 @@ struct Model {
     kappa_re: bool,
     params: Vec<(String, f64)>,
     at_bound: Vec<String>,
+    held: Vec<String>,
 }
 
 /// The recording with κ re-derived from `tyre`'s effective rolling radius:
@@ -88,6 +89,9 @@ impl Fitted for Model {
     fn at_bound(&self) -> Vec<String> {
         self.at_bound.clone()
     }
+    fn held(&self) -> Vec<String> {
+        self.held.clone()
+    }
 }
 
 /// The baseline itself.
@@ -121,6 +125,7 @@ impl Candidate for NoneCandidate {
             kappa_re: false,
             params: vec![],
             at_bound: vec![],
+            held: vec![],
         }))
     }
 }
@@ -256,6 +261,11 @@ pub struct Spec {
     /// load range; None from the function: the fit half cannot carry the
     /// candidate (one load level), which is then the baseline itself.
     pub from_data: Option<fn(&Recording, &[bool]) -> Option<Vec<(Target, f64)>>>,
+    /// The parameters are separate terms, each of which the physics may
+    /// lack (PPX1 … PPZ1 of the pressure candidate): after the full fit,
+    /// drop them one at a time while that lowers the fit half's evidence
+    /// statistic ([`eliminate`]), holding a dropped one at its start value.
+    pub eliminate: bool,
 }
 
 /// Whether `get` varies beyond its noise over the segments overlapping `mask`.
@@ -415,6 +425,132 @@ fn fit_lm(params: &[Param], resid: impl Fn(&[f64]) -> Option<Vec<f64>>) -> Vec<f
     crate::fit::lm::minimize(&problem, &start, &free, &opts, None).map_or(start, |r| r.theta)
 }
 
+/// Per channel block of a candidate's residual vector (blocks of `n`, the
+/// channels with data in [`Channel::SCORED`] order): its sum of squares.
+fn channel_sums(r: &[f64], n: usize) -> Vec<f64> {
+    r.chunks(n.max(1))
+        .map(|c| c.iter().map(|x| x * x).sum())
+        .collect()
+}
+
+/// Per channel with weight (the blocks of [`channel_sums`]): the samples
+/// of `idx` with a finite measurement.
+fn channel_counts(rec: &Recording, idx: &[usize], w: &[f64; 3]) -> Vec<usize> {
+    Channel::SCORED
+        .iter()
+        .zip(w)
+        .filter(|(_, w)| **w != 0.0)
+        .map(|(ch, _)| {
+            idx.iter()
+                .filter(|&&i| ch.measured(&rec.samples[i]).is_finite())
+                .count()
+        })
+        .collect()
+}
+
+/// The evidence statistic of a fit with `k` parameters: the AIC change of
+/// the channels taken as independent Gaussian observations, Σ_c
+/// n_c·ln(SSE_c/SSE_c,base) + 2k, n_c the channel's seconds
+/// ([`super::DECORRELATION_TIME`]). Each channel's evidence counts in full,
+/// so a term acting on Mz alone (a camber moment) stays when Mz needs it,
+/// however well another channel is already explained. AIC, not BIC: the
+/// elimination picks the terms that predict (Akaike's criterion estimates
+/// the expected held-out error; Burnham & Anderson, *Model Selection and
+/// Multimodel Inference*, 2nd ed., 2002, §2.2), and the verdict then asks
+/// the stricter BIC of what is left ([`super::ChannelScore::delta_bic`]).
+/// With BIC here the project's own proof lost real small terms (camber
+/// moment terms: 91–96 % → 45–66 % of the gap recovered).
+fn evidence(sse: &[f64], base: &[f64], secs: &[f64], k: usize) -> f64 {
+    let mut sum = 0.0;
+    let mut n_all = 0.0;
+    for ((e, b), s) in sse.iter().zip(base).zip(secs) {
+        let n = s / super::DECORRELATION_TIME;
+        if *b > 0.0 && n > 0.0 {
+            sum += n * (e / b).max(1e-300).ln();
+            n_all += n;
+        }
+    }
+    if n_all >= 2.0 {
+        sum + 2.0 * k as f64
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The entries of `v` whose `keep` is true.
+fn kept<T>(v: Vec<T>, keep: &[bool]) -> Vec<T> {
+    v.into_iter()
+        .zip(keep)
+        .filter(|(_, k)| **k)
+        .map(|(x, _)| x)
+        .collect()
+}
+
+/// Backward elimination ([`Spec::eliminate`]): from the full fit `theta`,
+/// refit without each active parameter in turn (held at its start) and drop
+/// the one whose removal gives the lowest [`evidence`], as long as that is
+/// no higher than with it; at least one parameter stays. Fit half only
+/// (the residuals `resid` see nothing else), so the held-out score still
+/// judges the result. Returns which parameters stay and the refitted θ
+/// (a held parameter at its start value).
+fn eliminate(
+    params: &[Param],
+    mut theta: Vec<f64>,
+    secs: &[f64],
+    base: &[f64],
+    resid: &impl Fn(&[f64]) -> Option<Vec<f64>>,
+    block: usize,
+) -> (Vec<bool>, Vec<f64>) {
+    let mut keep = vec![true; params.len()];
+    let score = |th: &[f64], k: usize| {
+        resid(th).map_or(f64::INFINITY, |r| {
+            evidence(&channel_sums(&r, block), base, secs, k)
+        })
+    };
+    let mut current = score(&theta, params.len());
+    loop {
+        let active: Vec<usize> = (0..params.len()).filter(|&i| keep[i]).collect();
+        if active.len() <= 1 {
+            break;
+        }
+        let mut best: Option<(usize, Vec<f64>, f64)> = None;
+        for &j in &active {
+            let rest: Vec<usize> = active.iter().copied().filter(|&i| i != j).collect();
+            let sub: Vec<Param> = rest
+                .iter()
+                .map(|&i| Param {
+                    init: theta[i],
+                    ..params[i].clone()
+                })
+                .collect();
+            let mut full = theta.clone();
+            full[j] = params[j].init;
+            let expand = |ts: &[f64]| {
+                let mut t = full.clone();
+                for (&i, v) in rest.iter().zip(ts) {
+                    t[i] = *v;
+                }
+                t
+            };
+            let ts = fit_lm(&sub, |ts: &[f64]| resid(&expand(ts)));
+            let t = expand(&ts);
+            let e = score(&t, rest.len());
+            if best.as_ref().is_none_or(|b| e < b.2) {
+                best = Some((j, t, e));
+            }
+        }
+        match best {
+            Some((j, t, e)) if e <= current => {
+                keep[j] = false;
+                theta = t;
+                current = e;
+            }
+            _ => break,
+        }
+    }
+    (keep, theta)
+}
+
 /// A candidate fitted by Levenberg–Marquardt ([`fit_lm`]) over the parameters of a
 /// [`Spec`] (built per baseline tyre; None: not applicable to that tyre, the
 /// fit is then the baseline itself).
@@ -444,7 +580,16 @@ impl Candidate for ParamCandidate {
         self.physics
     }
     fn describe(&self, f: &dyn Fitted) -> String {
-        (self.words)(f)
+        let held = f.held();
+        if held.is_empty() {
+            (self.words)(f)
+        } else {
+            format!(
+                "{} ({} held at the file's values: the fit half's evidence did not pay for them)",
+                (self.words)(f),
+                held.join(", ")
+            )
+        }
     }
     fn fit(
         &self,
@@ -513,6 +658,7 @@ impl Candidate for ParamCandidate {
                 kappa_re: spec.kappa_re,
                 params: vec![],
                 at_bound: vec![],
+                held: vec![],
             })
         };
         let resid = |theta: &[f64]| -> Option<Vec<f64>> {
@@ -570,7 +716,30 @@ impl Candidate for ParamCandidate {
                 }
             }
         }
+        let mut keep = vec![true; params.len()];
+        if spec.eliminate && params.len() > 1 {
+            let n_fit = mask.iter().filter(|x| **x).count();
+            let t: Vec<f64> = rec.samples.iter().map(|s| s.time).collect();
+            let h = crate::residual::median_spacing(&t);
+            let fit_secs = n_fit as f64 * if h.is_finite() && h > 0.0 { h } else { 0.02 };
+            let start: Vec<f64> = params.iter().map(|q| q.init).collect();
+            if let Some(base) = resid(&start).map(|r| channel_sums(&r, idx.len())) {
+                let counts = channel_counts(&work, &idx, w);
+                let secs: Vec<f64> = counts
+                    .iter()
+                    .map(|&c| fit_secs * c as f64 / idx.len().max(1) as f64)
+                    .collect();
+                (keep, theta) = eliminate(&params, theta, &secs, &base, &resid, idx.len());
+            }
+        }
         let mut m = model_of(&theta)?;
+        m.held = params
+            .iter()
+            .zip(&keep)
+            .filter(|(_, k)| !**k)
+            .map(|(q, _)| q.name.to_string())
+            .collect();
+        let (params, theta) = (kept(params, &keep), kept(theta, &keep));
         m.params = params
             .iter()
             .zip(&theta)
@@ -627,4 +796,49 @@ pub(super) fn file(t: &Tyre, k: &str) -> f64 {
 
 pub(super) fn is_mf6(t: &Tyre) -> bool {
     matches!(t.version(), MfVersion::Mf61 | MfVersion::Mf62)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One channel, y = 0.5·x + noise, and three candidate terms x, z, u
+    /// of which only x is in the data (z, u uncorrelated with the noise
+    /// pattern): the elimination holds z and u at their start and keeps
+    /// the slope of x; a fit whose terms all matter keeps them all.
+    #[test]
+    fn elimination_drops_the_terms_the_data_do_not_hold() {
+        let n = 400;
+        let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.05).sin()).collect();
+        let z: Vec<f64> = (0..n).map(|i| (i as f64 * 0.031 + 1.0).cos()).collect();
+        let u: Vec<f64> = (0..n).map(|i| i as f64 / n as f64 - 0.5).collect();
+        // Deterministic "noise": a fast oscillation no term can follow.
+        let e: Vec<f64> = (0..n).map(|i| 0.05 * (i as f64 * 2.7).sin()).collect();
+        let params: Vec<Param> = ["A", "B", "C"]
+            .iter()
+            .map(|&k| p(k, vec![], 0.0, -5.0, 5.0, 1e-4))
+            .collect();
+        let run = |y: &[f64]| {
+            let resid = |t: &[f64]| -> Option<Vec<f64>> {
+                Some(
+                    (0..n)
+                        .map(|i| y[i] - t[0] * x[i] - t[1] * z[i] - t[2] * u[i])
+                        .collect(),
+                )
+            };
+            let theta = fit_lm(&params, resid);
+            let base = channel_sums(&resid(&[0.0; 3]).unwrap(), n);
+            eliminate(&params, theta, &[n as f64], &base, &resid, n)
+        };
+        let y: Vec<f64> = (0..n).map(|i| 0.5 * x[i] + e[i]).collect();
+        let (keep, theta) = run(&y);
+        assert_eq!(keep, vec![true, false, false]);
+        assert!((theta[0] - 0.5).abs() < 0.01, "{theta:?}");
+        assert_eq!((theta[1], theta[2]), (0.0, 0.0));
+        let y: Vec<f64> = (0..n)
+            .map(|i| 0.5 * x[i] + 0.3 * z[i] - 0.4 * u[i] + e[i])
+            .collect();
+        let (keep, theta) = run(&y);
+        assert_eq!(keep, vec![true; 3], "{theta:?}");
+    }
 }

@@ -262,7 +262,8 @@ pub struct Spec {
     /// candidate (one load level), which is then the baseline itself.
     pub from_data: Option<fn(&Recording, &[bool]) -> Option<Vec<(Target, f64)>>>,
     /// The parameters are separate terms, each of which the physics may
-    /// lack (PPX1 … PPZ1 of the pressure candidate): after the full fit,
+    /// lack (the knot values of the load curves, the camber terms): after
+    /// the full fit,
     /// drop them one at a time while that lowers the fit half's evidence
     /// statistic ([`eliminate`]), holding a dropped one at its start value.
     pub eliminate: bool,

@@ -70,6 +70,43 @@ fn check_outputs(rep: &Path) -> serde_json::Value {
         assert!(NAMES.contains(&e["name"].as_str().unwrap()));
     }
     assert!(j["explanation"].as_str().unwrap().len() > 40);
+    // The other qualifying findings: each an evaluated effect whose own
+    // evidence says it qualifies, never the verdict, each named in the
+    // explanation; none listed when nothing is named.
+    let also = j["also_qualifying"].as_array().unwrap();
+    if verdict == "none" {
+        assert!(also.is_empty(), "{also:?}");
+    }
+    for a in also {
+        let a = a.as_str().unwrap();
+        assert_ne!(a, verdict);
+        let e = effects.iter().find(|e| e["name"] == a).unwrap();
+        assert!(
+            e["evidence"]
+                .as_str()
+                .unwrap()
+                .contains("Qualifies as a verdict"),
+            "{a}: {}",
+            e["evidence"]
+        );
+        assert!(j["explanation"]
+            .as_str()
+            .unwrap()
+            .contains(&format!("{a} (")));
+    }
+    for e in effects.iter().skip(1) {
+        if e["evidence"]
+            .as_str()
+            .unwrap()
+            .contains("Qualifies as a verdict")
+        {
+            assert!(
+                also.iter().any(|a| a == &e["name"]),
+                "{} unlisted",
+                e["name"]
+            );
+        }
+    }
     // Quality: an overall row per diagnosed channel, in and out of sample.
     for part in ["in_sample", "out_of_sample"] {
         let rows = j["quality"][part].as_array().unwrap();

@@ -29,7 +29,8 @@
 
 use super::candidate::param::rerolled;
 use super::candidate::{
-    all, channels_in_words, evaluate, select, why_not, Candidate, ChannelScore, Evaluation,
+    all, also_qualifying, channels_in_words, evaluate, select, why_not, Candidate, ChannelScore,
+    Evaluation,
 };
 use super::locate::{frictional_energy, locate, Finding, LocateOptions, Residuals};
 use super::slip_channel;
@@ -551,6 +552,9 @@ pub fn misfit_note(fits: &[BaselineFit]) -> Option<String> {
 pub struct DiagnosisReport {
     pub verdict: String,
     pub explanation: String,
+    /// Other candidates that also qualify ([`also_qualifying`]), lowest
+    /// BIC first: findings the data support besides the verdict.
+    pub also_qualifying: Vec<String>,
     pub effects: Vec<EffectReport>,
     pub quality: QualityReport,
     /// Findings per channel key ("FY").
@@ -776,6 +780,25 @@ pub fn diagnose_with(
             format!("{explanation} Also: {w}")
         };
     }
+    let also = also_qualifying(&ev, verdict_i);
+    if verdict_i.is_some() && !also.is_empty() {
+        let words: Vec<String> = also
+            .iter()
+            .map(|&i| {
+                let e = &ev[i].0;
+                format!(
+                    "{} ({}; BIC {:+.1})",
+                    e.name,
+                    channels_in_words(e),
+                    e.delta_bic
+                )
+            })
+            .collect();
+        explanation.push_str(&format!(
+            " Also supported by the data, with a higher BIC: {}. Each explains part of the same residual; the verdict is the one the evidence prefers.",
+            words.join("; ")
+        ));
+    }
     if verdict_i.is_some() {
         if let Some(c) = caution(&out_of_sample) {
             explanation.push(' ');
@@ -793,6 +816,11 @@ pub fn diagnose_with(
     let report = DiagnosisReport {
         verdict: verdict.clone(),
         explanation: explanation.clone(),
+        also_qualifying: if verdict_i.is_some() {
+            also.iter().map(|&i| ev[i].0.name.clone()).collect()
+        } else {
+            Vec::new()
+        },
         effects,
         quality: QualityReport {
             model_after: verdict.clone(),

@@ -91,7 +91,9 @@ mod thermal;
 /// Index of Fx, Fy, Mz in [`crate::residual::Channel::SCORED`] (and in the weights).
 pub use crate::residual::{FX, FY, MZ};
 pub use param::{NoneCandidate, Param, ParamCandidate, Spec, Target, STATIC_SAMPLES};
-pub use selection::{channels_in_words, qualifies, select, why_not, MAX_LOSS, MIN_GAIN};
+pub use selection::{
+    also_qualifying, channels_in_words, qualifies, select, why_not, MAX_LOSS, MIN_GAIN,
+};
 pub use statistics::{
     evaluate, fit_weights, held_out_sse, smoothed_inputs, split, ChannelScore, Evaluation,
     DECORRELATION_TIME, SMOOTH_HALF_WIDTH,

@@ -59,6 +59,20 @@ pub fn select(ev: &[(Evaluation, Box<dyn Fitted>)]) -> Option<usize> {
         .map(|(i, _)| i)
 }
 
+/// The other qualifying candidates ([`qualifies`]) besides the verdict
+/// `winner`, lowest pooled BIC first: findings the data also support. Two
+/// candidates that both qualify each explain part of the same residual (a
+/// drift with time can read as heating and as a pressure that rises with
+/// it); the verdict is the one the evidence prefers, and a tyre engineer
+/// should hear of the other.
+pub fn also_qualifying(ev: &[(Evaluation, Box<dyn Fitted>)], winner: Option<usize>) -> Vec<usize> {
+    let mut v: Vec<usize> = (0..ev.len())
+        .filter(|&i| Some(i) != winner && qualifies(&ev[i].0))
+        .collect();
+    v.sort_by(|&a, &b| ev[a].0.delta_bic.total_cmp(&ev[b].0.delta_bic));
+    v
+}
+
 /// The held-out change of each channel's squared error and the channel's
 /// BIC change in words ("Fy −5.4 % (BIC −12.0), Mz +0.2 % (BIC +9.1)";
 /// − = better).
@@ -125,7 +139,7 @@ pub fn why_not(e: &Evaluation) -> Option<String> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::ChannelScore;
+    use super::super::{Candidate, ChannelScore};
     use super::*;
     use crate::residual::Channel;
 
@@ -188,6 +202,36 @@ mod tests {
         assert!(!qualifies(&weak));
         let why = why_not(&weak).unwrap();
         assert!(why.contains("BIC") && why.contains("Fx +5.0"), "{why}");
+    }
+
+    /// Every qualifying candidate but the verdict is listed, lowest pooled
+    /// BIC first; one that does not qualify is not.
+    #[test]
+    fn the_other_qualifying_candidates_are_listed_by_bic() {
+        let strong = |bic: f64| ev(&[(Channel::Fy, 0.10, -30.0)], 0.08, bic);
+        let weak = ev(&[(Channel::Fy, 0.01, 3.0)], 0.01, 5.0);
+        let boxed = |e: Evaluation| -> (Evaluation, Box<dyn Fitted>) {
+            let none = super::super::NoneCandidate
+                .fit(
+                    &crate::data::Recording::default(),
+                    &crate::mf::Tyre::builtin(),
+                    &crate::residual::ReplayOptions::default(),
+                    &[],
+                    &[1.0; 3],
+                )
+                .unwrap();
+            (e, none)
+        };
+        let list = vec![
+            boxed(strong(-5.0)),
+            boxed(weak),
+            boxed(strong(-40.0)),
+            boxed(strong(-12.0)),
+        ];
+        let winner = select(&list);
+        assert_eq!(winner, Some(2));
+        assert_eq!(also_qualifying(&list, winner), vec![3, 0]);
+        assert_eq!(also_qualifying(&list, None), vec![2, 3, 0]);
     }
 
     /// Below MIN_GAIN in every channel: noise, whatever the BICs say.

@@ -700,7 +700,7 @@ impl Candidate for ParamCandidate {
             }
         }
         let cost = |t: &[f64]| resid(t).map_or(f64::INFINITY, |r| r.iter().map(|x| x * x).sum());
-        let mut theta = fit_lm(&params, &resid);
+        let mut theta = fit_lm(&params, resid);
         if !spec.restarts.is_empty() {
             let mut best = cost(&theta);
             for over in &spec.restarts {
@@ -710,7 +710,7 @@ impl Candidate for ParamCandidate {
                         x.init = *v;
                     }
                 }
-                let t = fit_lm(&q, &resid);
+                let t = fit_lm(&q, resid);
                 let c = cost(&t);
                 if c < best {
                     (theta, best) = (t, c);

@@ -780,8 +780,9 @@ pub fn diagnose_with(
             format!("{explanation} Also: {w}")
         };
     }
+    // Empty without a verdict: `select` names one whenever any qualifies.
     let also = also_qualifying(&ev, verdict_i);
-    if verdict_i.is_some() && !also.is_empty() {
+    if !also.is_empty() {
         let words: Vec<String> = also
             .iter()
             .map(|&i| {
@@ -816,11 +817,7 @@ pub fn diagnose_with(
     let report = DiagnosisReport {
         verdict: verdict.clone(),
         explanation: explanation.clone(),
-        also_qualifying: if verdict_i.is_some() {
-            also.iter().map(|&i| ev[i].0.name.clone()).collect()
-        } else {
-            Vec::new()
-        },
+        also_qualifying: also.iter().map(|&i| ev[i].0.name.clone()).collect(),
         effects,
         quality: QualityReport {
             model_after: verdict.clone(),

@@ -136,22 +136,19 @@ fn combined_fit_agrees_in_use_modes_111_and_211() {
     assert_modes_agree(&written(&res.tyre), &recs, "r15 all stages");
 }
 
-/// TyreData through the written file in use mode 111 (as `tyrekit eval`
-/// computes it): σ_Fy ≤ 4 %, σ_Mz ≤ 15 % (issue #14's figures; the fit's
-/// own σ uses the same metric, so a fit valid in 111 prints what the file
-/// gives).
-#[test]
-#[ignore = "not met: measured σ_Fy 4.47 %, σ_Mz 19.83 % in use mode 111 on 27 Nov (issue: ≤ 4 %, ≤ 15 %)"]
-fn tyredata_sigma_through_the_written_file_in_use_mode_111() {
-    let Some(rec) = tyredata() else { return };
-    let recs = [rec];
+/// TyreData fitted as `tyrekit fit --only fy,mz` does (pure Fy and Mz from
+/// the built-in start), the written file evaluated in use mode 111 as
+/// `tyrekit eval` and the FMU compute it: (the recording, σ_Fy, σ_Mz on the
+/// lateral sweeps, the σ_Fy the fit printed).
+fn tyredata_fit_sigmas() -> Option<(Recording, f64, f64, f64)> {
+    let recs = [tyredata()?];
     let opts = MfFitOptions {
         only: vec![StageKind::PureFy, StageKind::Mz],
         ..Default::default()
     };
     let res = fit_mf(&recs, TyreParams::builtin(), &opts, None).unwrap();
     let tyre = written(&res.tyre);
-    let rec = &recs[0];
+    let [rec] = recs;
     let sim: Vec<_> = rec
         .samples
         .iter()
@@ -177,7 +174,7 @@ fn tyredata_sigma_through_the_written_file_in_use_mode_111() {
         .map(|g| g.start..g.end)
         .collect();
     let sigma = |ch: &str, v: Vec<f64>| {
-        metrics::evaluate(rec, ch, &v, Some(&lateral))
+        metrics::evaluate(&rec, ch, &v, Some(&lateral))
             .unwrap()
             .into_iter()
             .find(|m| m.condition.is_none())
@@ -191,12 +188,83 @@ fn tyredata_sigma_through_the_written_file_in_use_mode_111() {
         100.0 * s_fy,
         100.0 * s_mz
     );
+    let own = tyrekit::fit::mf_fit::overall_sigma(&res.report.metrics, "Fy").unwrap();
+    Some((rec, s_fy, s_mz, own))
+}
+
+/// TyreData through the written file in use mode 111 (as `tyrekit eval`
+/// computes it): σ_Fy ≤ 4 %, σ_Mz ≤ 15 % (issue #14's figures; the fit's
+/// own σ uses the same metric, so a fit valid in 111 prints what the file
+/// gives).
+#[test]
+#[ignore = "not met: measured σ_Fy 4.47 %, σ_Mz 19.83 % in use mode 111 on 27 Nov (issue: ≤ 4 %, ≤ 15 %; σ_Mz 15 % lies below the steady floor 17.6 %, see tyredata_fit_is_near_the_steady_floor)"]
+fn tyredata_sigma_through_the_written_file_in_use_mode_111() {
+    let Some((_, s_fy, s_mz, own)) = tyredata_fit_sigmas() else {
+        return;
+    };
     assert!(s_fy <= 0.04, "σ_Fy {:.2} % > 4 %", 100.0 * s_fy);
     assert!(s_mz <= 0.15, "σ_Mz {:.2} % > 15 %", 100.0 * s_mz);
     // The fit's own figure is the file's.
-    let own = tyrekit::fit::mf_fit::overall_sigma(&res.report.metrics, "Fy").unwrap();
     assert!(
         (own - s_fy).abs() <= 1e-9,
         "fit printed σ_Fy {own}, the file gives {s_fy}"
     );
+}
+
+/// The fit against the best any steady curve of α reaches per test
+/// condition on TyreData: per lateral sweep (one load, inclination and
+/// pressure each, 45 of them) a least-squares polynomial of degree 11 in α
+/// (Chebyshev basis on α/0.2 rad; 540 coefficients against the MF's ~50).
+/// Its σ is the floor of a steady model on these data; what is left is
+/// noise and the force's lag behind α (at 5 Hz the sweeps move ~1° per
+/// sample). Measured 27 Nov 2026: floor σ_Fy 2.30 %, σ_Mz 17.57 %; the
+/// written file 4.47 % (1.94×) and 19.83 % (1.13×). So the issue's σ_Mz ≤
+/// 15 % is below what any steady function of the conditions and α reaches
+/// here, and the test above stays ignored for Mz on that ground. Bounds: Mz
+/// within 1.2× of the floor (the MF's ~25 Mz coefficients cost 13 %); Fy
+/// within 2.2× — the rest is MF 6.1's friction linear in load (PDY1 +
+/// PDY2·dfz) against a measured peak μ that rises from 0.92 at 310 N to
+/// 1.17 at 760 N and falls to 1.10 at 1650 N, which no E ≤ 1 curve can
+/// follow.
+#[test]
+fn tyredata_fit_is_near_the_steady_floor() {
+    let Some((rec, s_fy, s_mz, _)) = tyredata_fit_sigmas() else {
+        return;
+    };
+    let floor = |ch: fn(&tyrekit::data::Sample) -> f64| {
+        let (mut e, mut t) = (0.0, 0.0);
+        for g in rec
+            .segments
+            .iter()
+            .filter(|g| g.kind == tyrekit::data::SegmentKind::PureLateral)
+        {
+            let rows: Vec<_> = rec.samples[g.start..g.end]
+                .iter()
+                .filter(|s| ch(s).is_finite() && s.alpha.is_finite())
+                .collect();
+            const DEG: usize = 11;
+            assert!(rows.len() > 3 * (DEG + 1), "sweep of {} rows", rows.len());
+            let x = nalgebra::DMatrix::from_fn(rows.len(), DEG + 1, |i, k| {
+                let u = (rows[i].alpha / 0.2).clamp(-1.0, 1.0);
+                (k as f64 * u.acos()).cos()
+            });
+            let y = nalgebra::DVector::from_iterator(rows.len(), rows.iter().map(|s| ch(s)));
+            let c = x.clone().svd(true, true).solve(&y, 1e-12).unwrap();
+            e += (&x * c - &y).norm_squared();
+            t += y.norm_squared();
+        }
+        (e / t).sqrt()
+    };
+    let (f_fy, f_mz) = (floor(|s| s.fy), floor(|s| s.mz));
+    println!(
+        "TyreData steady floor σ_Fy {:.2} %, σ_Mz {:.2} %; the fitted file {:.2} % ({:.2}×), {:.2} % ({:.2}×)",
+        100.0 * f_fy,
+        100.0 * f_mz,
+        100.0 * s_fy,
+        s_fy / f_fy,
+        100.0 * s_mz,
+        s_mz / f_mz
+    );
+    assert!(s_mz <= 1.2 * f_mz, "σ_Mz {s_mz} against the floor {f_mz}");
+    assert!(s_fy <= 2.2 * f_fy, "σ_Fy {s_fy} against the floor {f_fy}");
 }

@@ -94,6 +94,7 @@ pub fn run(args: Args) -> Result<()> {
     let mut start = match &args.start {
         Some(p) => {
             opts.nominal_from_data = false;
+            opts.generic_start = false;
             let t = TyreParams::from_file(p)?;
             super::show_warnings(&p.display().to_string(), &t.warnings);
             t

@@ -40,6 +40,11 @@ pub struct MfFitOptions {
     pub t_origins: Vec<Option<f64>>,
     /// Take FNOMIN, NOMPRES (and INFLPRES), LONGVL from the data.
     pub nominal_from_data: bool,
+    /// The start tyre is a generic one (the built-in), not a file of the
+    /// tyre under test: coefficients the data cannot determine and that
+    /// have a neutral value are held at it rather than at another tyre's
+    /// ([`NEUTRAL_SLIP_ANGLE_SHAPE`]). `tyrekit fit --start` turns it off.
+    pub generic_start: bool,
     /// Fit the radii and vertical stiffness keys to the recorded Re and Rl
     /// before the force stages ([`super::geometry`]; R0 enters the Mz, Mx,
     /// My equations). Off by default (the diagnosis baseline holds Re terms
@@ -59,6 +64,7 @@ impl Default for MfFitOptions {
             holdout: Holdout::None,
             t_origins: Vec::new(),
             nominal_from_data: true,
+            generic_start: true,
             geometry: false,
             threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
             fit: FitOptions {
@@ -271,12 +277,6 @@ pub(crate) enum StageRun {
     Done(super::solve::FitOutcome, Vec<Channel>),
 }
 
-/// Run stage `kind` from the values of `tyre` on the fitted rows: its
-/// channels where recorded, its samples (the combined stage: the combined
-/// rows and the pure ones, see below), its parameter table. `multi_start`:
-/// converge from the current values, the neutral start and the data-driven
-/// one ([`super::initial`]) and polish the best; otherwise polish from the
-/// current values only (a re-fit after a later stage).
 /// Combined-slip coefficients that shape the weights' dependence on the
 /// slip angle (Pacejka, *Tyre and Vehicle Dynamics*, eqs. 4.E54–4.E57 for
 /// Gxα: Cxα, Exα; 4.E62–4.E67 for Gyκ and SVyκ: the α terms of Byκ and
@@ -284,7 +284,33 @@ pub(crate) enum StageRun {
 /// angle only — the shape is then a free extrapolation (collinear with RBX1,
 /// RBY1, RVY1, and driven to its bounds by noise) — so these are held at
 /// their start values unless the combined runs cover two slip angles or more.
-const SLIP_ANGLE_SHAPE: [&str; 6] = ["rcx1", "rex1", "rex2", "rby2", "rby3", "rvy4"];
+/// Exα's load trend REX2 is not among them: see [`SLIP_ANGLE_LOAD_TREND`].
+const SLIP_ANGLE_SHAPE: [&str; 5] = ["rcx1", "rex1", "rby2", "rby3", "rvy4"];
+
+/// Neutral values of the held Gxα shape terms (eqs. 4.E55–4.E56): Cxα = 1,
+/// Exα = 0 make the weight cos(atan(Bxα·α)), a curve with no curvature term
+/// the data did not show. They replace the start file's values when the
+/// start is a generic tyre ([`MfFitOptions::generic_start`]): its values
+/// belong to another tyre, and borrowed ones set the extrapolation to slip
+/// angles the data do not hold (dev set, runs at −3° scored at −6°: the
+/// built-in car tyre's Exα −0.44 made the fitted FSAE tyres' Fx 10–20 % low
+/// at −6°; the neutral shape about halves that error, and on the car tyres
+/// it changes their all-row Fx NRMSE by < 0.1 × the peer's).
+const NEUTRAL_SLIP_ANGLE_SHAPE: [(&str, f64); 2] = [("rcx1", 1.0), ("rex1", 0.0)];
+
+/// Exα's load trend (REX2, eq. 4.E56), the one load-dependent term of Gxα in
+/// MF 6.1. At a single slip angle the weight curves G(κ) of several loads
+/// differ only through it, so drive/brake runs at two loads or more
+/// determine it even where they hold one angle (its level REX1 trades with
+/// RBX1 there and stays held). Held when the runs' loads span less than
+/// [`LOAD_SPREAD_FOR_TREND`] of FNOMIN.
+const SLIP_ANGLE_LOAD_TREND: &str = "rex2";
+
+/// Spread of the drive/brake samples' normalised load change dfz (5th to
+/// 95th percentile) from which they count as runs at several loads: test
+/// plans step the load by ≥ 25 % of FNOMIN, while a regulated single load
+/// scatters by a few per cent.
+const LOAD_SPREAD_FOR_TREND: f64 = 0.25;
 
 /// The slip-angle offset of Gxα (SHxα = RHX1, eq. 4.E57): an asymmetry of
 /// the weight between positive and negative slip angles, seen only when the
@@ -319,13 +345,15 @@ fn held_shape_note(out: &super::solve::FitOutcome) -> Option<String> {
         .filter(|p| matches!(p.status, super::solve::ParamStatus::Fixed))
         .filter(|p| {
             let n = p.name.to_ascii_lowercase();
-            SLIP_ANGLE_SHAPE.contains(&n.as_str()) || n == SLIP_ANGLE_ASYMMETRY
+            SLIP_ANGLE_SHAPE.contains(&n.as_str())
+                || n == SLIP_ANGLE_ASYMMETRY
+                || n == SLIP_ANGLE_LOAD_TREND
         })
-        .map(|p| p.name.to_ascii_uppercase())
+        .map(|p| format!("{} = {}", p.name.to_ascii_uppercase(), p.value))
         .collect();
     (!held.is_empty()).then(|| {
         format!(
-            "combined stage: the drive/brake runs cover one slip-angle level or one sign of the slip angle, which does not determine how the combined-slip weights change with it; {} held at the start file's values, so combined forces at slip angles the data do not hold are that shape extrapolated, not fitted",
+            "combined stage: the drive/brake runs cover one slip-angle level or one sign of the slip angle, which does not determine how the combined-slip weights change with it; {} held (the start file's values, or the neutral Gxα shape RCX1 = 1, REX1 = 0 when the start is the built-in tyre), so combined forces at slip angles the data do not hold are that shape extrapolated, not fitted",
             held.join(", ")
         )
     })
@@ -348,6 +376,29 @@ fn slip_angle_levels(conds: &[crate::mf::Conditions]) -> usize {
     bins.iter().filter(|(&b, &k)| b != 0 && k * 20 >= n).count()
 }
 
+/// The 5th-to-95th-percentile spread of the normalised load change dfz of
+/// the drive/brake samples (|κ| > 0.01) of `conds` ([`LOAD_SPREAD_FOR_TREND`]);
+/// 0 without such samples.
+fn drive_brake_load_spread(conds: &[crate::mf::Conditions], fz0: f64) -> f64 {
+    let mut dfz: Vec<f64> = conds
+        .iter()
+        .filter(|c| c.kappa.abs() > 0.01 && c.fz.is_finite())
+        .map(|c| (c.fz - fz0) / fz0)
+        .collect();
+    if dfz.len() < 2 || !fz0.is_finite() || fz0 <= 0.0 {
+        return 0.0;
+    }
+    dfz.sort_by(f64::total_cmp);
+    let at = |q: f64| dfz[((dfz.len() - 1) as f64 * q).round() as usize];
+    at(0.95) - at(0.05)
+}
+
+/// Run stage `kind` from the values of `tyre` on the fitted rows: its
+/// channels where recorded, its samples (the combined stage: the combined
+/// rows and the pure ones, see below), its parameter table. `multi_start`:
+/// converge from the current values, the neutral start and the data-driven
+/// one ([`super::initial`]) and polish the best; otherwise polish from the
+/// current values only (a re-fit after a later stage).
 pub(crate) fn run_stage(
     ctx: &StageCtx,
     kind: StageKind,
@@ -385,6 +436,7 @@ pub(crate) fn run_stage(
     // join them (see `SLIP_ANGLE_SHAPE`).
     let combined_alpha_levels = slip_angle_levels(&data.conds);
     let combined_both_signs = slip_angle_both_signs(&data.conds);
+    let combined_load_spread = drive_brake_load_spread(&data.conds, tyre.p.fnomin);
     if kind == StageKind::Combined {
         // The combined weights act on the pure rows too (κ and α are
         // never exactly 0 there: Gyκ, SVyκ, Gxα and Mz's s·Fx apply), so
@@ -406,8 +458,17 @@ pub(crate) fn run_stage(
             let name = p.name.to_ascii_lowercase();
             let shape = combined_alpha_levels < 2 && SLIP_ANGLE_SHAPE.contains(&name.as_str());
             let asym = !combined_both_signs && name == SLIP_ANGLE_ASYMMETRY;
-            if shape || asym {
+            let trend = combined_alpha_levels < 2
+                && combined_load_spread < LOAD_SPREAD_FOR_TREND
+                && name == SLIP_ANGLE_LOAD_TREND;
+            if shape || asym || trend {
                 *p = p.clone().fixed();
+                if shape && opts.generic_start {
+                    if let Some(&(_, v)) = NEUTRAL_SLIP_ANGLE_SHAPE.iter().find(|(k, _)| *k == name)
+                    {
+                        p.start = v;
+                    }
+                }
             }
         }
     }
@@ -593,7 +654,9 @@ pub fn overall_sigma(m: &[ChannelMetric], channel: &str) -> Option<f64> {
 
 #[cfg(test)]
 mod tests {
-    use super::{slip_angle_both_signs, slip_angle_levels};
+    use super::{
+        drive_brake_load_spread, slip_angle_both_signs, slip_angle_levels, LOAD_SPREAD_FOR_TREND,
+    };
     use crate::mf::Conditions;
 
     fn runs(levels_deg: &[f64]) -> Vec<Conditions> {
@@ -632,6 +695,34 @@ mod tests {
     }
 
     #[test]
+    fn load_spread_tells_runs_at_several_loads_from_one() {
+        // Drive/brake samples at a regulated load scattering by ±2 %.
+        let at = |fz: f64, n: usize| {
+            (0..n).map(move |i| Conditions {
+                fz: fz * (1.0 + 0.02 * ((i % 7) as f64 - 3.0) / 3.0),
+                kappa: 0.1,
+                ..Default::default()
+            })
+        };
+        // One load: its scatter is no load trend.
+        let one: Vec<Conditions> = at(1000.0, 200).collect();
+        assert!(drive_brake_load_spread(&one, 1000.0) < LOAD_SPREAD_FOR_TREND);
+        // Loads of 0.2 … 1.4 × FNOMIN: dfz spans −0.8 … +0.4.
+        let four: Vec<Conditions> = [200.0, 600.0, 1000.0, 1400.0]
+            .iter()
+            .flat_map(|&f| at(f, 100))
+            .collect();
+        let spread = drive_brake_load_spread(&four, 1000.0);
+        assert!((spread - 1.2).abs() < 0.05, "spread {spread}");
+        // Free-rolling samples (|κ| ≤ 0.01) are no drive/brake runs.
+        let free: Vec<Conditions> = four
+            .iter()
+            .map(|c| Conditions { kappa: 0.0, ..*c })
+            .collect();
+        assert_eq!(drive_brake_load_spread(&free, 1000.0), 0.0);
+    }
+
+    #[test]
     fn held_slip_angle_terms_are_said() {
         use crate::fit::solve::{FitOutcome, ParamResult, ParamStatus};
         let r = |name: &str, status: ParamStatus| ParamResult {
@@ -659,7 +750,7 @@ mod tests {
             termination: crate::fit::lm::Termination::Cost,
         };
         let note = super::held_shape_note(&out).expect("held terms are said");
-        assert!(note.contains("RCX1, RHX1") && note.contains("extrapolated"));
+        assert!(note.contains("RCX1 = 1, RHX1 = 1") && note.contains("extrapolated"));
         assert!(!note.contains("RBX1"));
         // Nothing held (two levels, both signs): nothing said.
         out.params.retain(|p| p.name == "rbx1");

@@ -294,8 +294,9 @@ const SLIP_ANGLE_SHAPE: [&str; 5] = ["rcx1", "rex1", "rby2", "rby3", "rvy4"];
 /// belong to another tyre, and borrowed ones set the extrapolation to slip
 /// angles the data do not hold (dev set, runs at −3° scored at −6°: the
 /// built-in car tyre's Exα −0.44 made the fitted FSAE tyres' Fx 10–20 % low
-/// at −6°; the neutral shape about halves that error, and on the car tyres
-/// it changes their all-row Fx NRMSE by < 0.1 × the peer's).
+/// at −6°; with the neutral shape and REX2 fitted their all-row Fx went
+/// from 2.0–2.6 to 1.1–1.4 × the peer's, while the car tyres, whose own
+/// shape is nearer the built-in one, lost 0.1–0.2 × (r15 1.08 → 1.26 ×)).
 const NEUTRAL_SLIP_ANGLE_SHAPE: [(&str, f64); 2] = [("rcx1", 1.0), ("rex1", 0.0)];
 
 /// Exα's load trend (REX2, eq. 4.E56), the one load-dependent term of Gxα in

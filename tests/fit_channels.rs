@@ -9,7 +9,7 @@
 
 mod common;
 
-use tyrekit::fit::channels::eval;
+use tyrekit::fit::channels::{eval, eval_given};
 use tyrekit::fit::mf_stages::{conditions_of, Channel};
 use tyrekit::mf::num_dual::Dual64;
 use tyrekit::mf::{form_of, Model};
@@ -55,6 +55,19 @@ fn samples(t: &TyreParams) -> Vec<tyrekit::data::Sample> {
     out
 }
 
+/// `t`'s model with key `k` seeded as the dual part.
+fn seeded(t: &TyreParams, k: &str) -> Model<Dual64> {
+    let ki = key_index(k).unwrap();
+    let pd = t.p.map(|i, v| {
+        if i == ki {
+            Dual64::new(v, 1.0)
+        } else {
+            Dual64::from(v)
+        }
+    });
+    Model::new(pd, form_of(t.version))
+}
+
 #[test]
 fn one_channel_values_are_bit_identical_to_solve() {
     for t in tyres() {
@@ -78,15 +91,7 @@ fn one_channel_derivatives_match_solve() {
     ];
     for t in tyres() {
         for k in keys {
-            let ki = key_index(k).unwrap();
-            let pd = t.p.map(|i, v| {
-                if i == ki {
-                    Dual64::new(v, 1.0)
-                } else {
-                    Dual64::from(v)
-                }
-            });
-            let m = Model::new(pd, form_of(t.version));
+            let m = seeded(&t, k);
             for s in samples(&t).iter().step_by(7) {
                 let c = conditions_of(&t.p, s);
                 let full = m.solve(&c);
@@ -98,6 +103,41 @@ fn one_channel_derivatives_match_solve() {
                         t.source
                     );
                 }
+            }
+        }
+    }
+}
+
+#[test]
+fn moments_given_their_force_are_the_one_channel_values() {
+    // The Mx (My) stage computes Fy (Fx) once per sample and passes it in:
+    // in `f64` the value must be the same bits as evaluating the force
+    // inside; with a moment coefficient seeded, value and derivative the
+    // same to rounding (1e-12 relative, as above: the force carries no
+    // derivative of a moment coefficient either way, but the dual model's
+    // Fy is its own rounding of the `f64` one; measured: ulps apart).
+    for t in tyres() {
+        let mf = Model::new(t.p.clone(), form_of(t.version));
+        for (k, ch, force) in [
+            ("QSX3", Channel::Mx, Channel::Fy),
+            ("QSX9", Channel::Mx, Channel::Fy),
+            ("QSY1", Channel::My, Channel::Fx),
+            ("QSY2", Channel::My, Channel::Fx),
+        ] {
+            let m = seeded(&t, k);
+            for s in samples(&t).iter().step_by(3) {
+                let c = conditions_of(&t.p, s);
+                let f = eval(&mf, &c, force);
+                let (a, b) = (eval_given(&m, &c, ch, Some(f)), eval(&m, &c, ch));
+                for (what, x, y) in [("value", a.re, b.re), ("derivative", a.eps, b.eps)] {
+                    assert!(
+                        (x - y).abs() <= 1e-12 * y.abs().max(1e-300),
+                        "{} {ch:?} {what} (d/d{k}): {x} vs {y}",
+                        t.source
+                    );
+                }
+                let v = eval_given(&mf, &c, ch, Some(f));
+                assert_eq!(v.to_bits(), eval(&mf, &c, ch).to_bits());
             }
         }
     }

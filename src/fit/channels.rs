@@ -29,3 +29,21 @@ pub fn eval<T: Real>(model: &Model<T>, c: &Conditions, channel: Channel) -> T {
         Channel::Fz => T::from(f64::NAN),
     }
 }
+
+/// [`eval`] with the force the moment needs already known: `given` is
+/// Fy for [`Channel::Mx`] and Fx for [`Channel::My`] (their `f64` values
+/// at this sample, valid when no parameter that moves them carries a dual
+/// lane); ignored for the other channels. Same bits as [`eval`].
+#[inline]
+pub fn eval_given<T: Real>(
+    model: &Model<T>,
+    c: &Conditions,
+    channel: Channel,
+    given: Option<f64>,
+) -> T {
+    match (channel, given) {
+        (Channel::Mx, Some(fy)) => model.mx_with_fy(c, T::c(fy)),
+        (Channel::My, Some(fx)) => model.my_with_fx(c, T::c(fx)),
+        _ => eval(model, c, channel),
+    }
+}

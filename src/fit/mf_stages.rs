@@ -274,6 +274,22 @@ impl StageData {
 /// takes two or three iterations.
 pub const COARSE_SAMPLES: usize = 10_000;
 
+/// Size of the subsample the starts of a multi-start stage race on
+/// ([`best_start`]; stages with more than twice this many samples use every
+/// k-th sample with k = m / `RACE_SAMPLES`). The race only decides which
+/// basin the winner comes from — it is judged on the full data and then
+/// converged on the [`COARSE_SAMPLES`] subsample and the full data — so it
+/// needs the curve shapes, not the last digit: 3 000 samples are still
+/// ≈ 100 per parameter of the largest stage (combined, ≈ 30), and every
+/// sweep of a 100 Hz recording keeps a point each ≈ 0.1 s. On the dev set's
+/// 84 000-line recordings the two Mz starts took 5 of a fit's 14 s
+/// racing on 11 500 samples. Only stages evaluated through num-dual race
+/// on it (Mz, combined, Mx, My); the closed-form pure-slip stages race on
+/// the coarse subsample (on dev-set r03, whose pure-Fy valley of collinear
+/// PKY2/PKY4/PKY5 makes the end point depend on the path, the small race
+/// had moved held-out pure Fy 0.91 → 0.96× the answer's baseline).
+pub const RACE_SAMPLES: usize = 3_000;
+
 /// Fit one Magic Formula stage: the `channels` of `data` (channel k ↔
 /// `data.meas[k]`; several channels are stacked with weights 1/mean(y²), so
 /// newtons and newton-metres compare) over `params`, from `base`, on
@@ -361,6 +377,20 @@ pub fn fit_stage_from(
         Some(d) => parts_of(form, base, params, d, channels, &weights, threads)?,
         None => Vec::new(),
     };
+    // Stages with closed-form Jacobians (pure Fx, pure Fy) race on the
+    // coarse subsample: there the race costs little (≈ 0.1–0.4 s), and the
+    // smaller subsample would trade start choice for nothing worth having.
+    let dual = parts.iter().any(|p| p.analytic.is_none());
+    let race = (opts.coarse_first && !extra_starts.is_empty() && m > 2 * RACE_SAMPLES && dual)
+        .then(|| data.every(m / RACE_SAMPLES));
+    // The same for the quick full-data polish (`FitOptions::quick_polish`).
+    let mut opts = opts.clone();
+    opts.quick_polish |= dual;
+    let opts = &opts;
+    let race_parts = match &race {
+        Some(d) => parts_of(form, base, params, d, channels, &weights, threads)?,
+        None => Vec::new(),
+    };
     // The validity rows, scaled to the weighted energy of the data they join.
     let validity = |d: &StageData| -> crate::Result<Option<Validity>> {
         let Some(grid) = &d.grid else { return Ok(None) };
@@ -374,6 +404,10 @@ pub fn fit_stage_from(
     };
     let valid = validity(data)?;
     let coarse_valid = match &coarse {
+        Some(d) => validity(d)?,
+        None => None,
+    };
+    let race_valid = match &race {
         Some(d) => validity(d)?,
         None => None,
     };
@@ -393,15 +427,23 @@ pub fn fit_stage_from(
     }
     let stack = stacked(&parts, &valid)?;
     let coarse_stack = stacked(&coarse_parts, &coarse_valid)?;
+    let race_stack = stacked(&race_parts, &race_valid)?;
     let problem: &dyn Problem = match &stack {
         Some(s) => s,
         None => &parts[0],
     };
-    let coarse_problem: Option<&dyn Problem> = match (&coarse_stack, coarse_parts.first()) {
-        (Some(s), _) => Some(s),
-        (None, Some(p)) => Some(p),
-        (None, None) => None,
-    };
+    fn one_of<'p>(
+        stack: &'p Option<Stack<'_>>,
+        parts: &'p [MfStage<'_>],
+    ) -> Option<&'p dyn Problem> {
+        match (stack, parts.first()) {
+            (Some(s), _) => Some(s),
+            (None, Some(p)) => Some(p),
+            (None, None) => None,
+        }
+    }
+    let coarse_problem = one_of(&coarse_stack, &coarse_parts);
+    let race_problem = one_of(&race_stack, &race_parts);
     drop(t_build);
     let mut start = None;
     if !extra_starts.is_empty() {
@@ -409,7 +451,7 @@ pub fn fit_stage_from(
             super::timing::span(|| format!("  {name}: best_start ({})", extra_starts.len() + 1));
         start = Some(best_start(
             problem,
-            coarse_problem,
+            race_problem.or(coarse_problem),
             extra_starts,
             opts,
             name,
@@ -436,8 +478,8 @@ pub fn fit_stage_from(
 pub const START_ITERATIONS: usize = 50;
 
 /// Several starts (issue #14 item 3): the problem's own and `extra`, each
-/// converged on the subsample `coarse` (to 1e-6; on the problem itself when
-/// there is none), judged by the full problem's cost — with a subsample
+/// converged on the subsample `coarse` (to 1e-6; the [`RACE_SAMPLES`]
+/// subsample when the stage is large, the problem itself when it is not), judged by the full problem's cost — with a subsample
 /// that is the error on the (k − 1)/k samples the candidate was not fitted
 /// on, a held-out figure. Returns the best converged point.
 fn best_start(
@@ -594,6 +636,10 @@ pub struct MfStage<'a> {
     weights: Option<Vec<f64>>,
     /// The closed-form path, when it applies and is on.
     analytic: Option<Analytic>,
+    /// Mx (My) stages whose every parameter is an Mx (My) coefficient: the
+    /// combined-slip Fy (Fx) of every sample, which θ cannot move
+    /// ([`channels::eval_given`]).
+    given: Option<Vec<f64>>,
     /// Threads for evaluation (results do not depend on it).
     pub threads: usize,
 }
@@ -651,6 +697,23 @@ impl<'a> MfStage<'a> {
         let meas = data.meas.get(k).ok_or_else(|| {
             crate::Error::Input(format!("fit: the stage data have no channel {k}"))
         })?;
+        // The force an Mx (My) stage's moment needs, once: its table moves
+        // no force coefficient (checked by name, so a custom table that
+        // does falls back to evaluating the force per pass).
+        let force = match channel {
+            Channel::Mx => Some((MX, Channel::Fy)),
+            Channel::My => Some((MY, Channel::Fx)),
+            _ => None,
+        };
+        let given = force
+            .filter(|(table, _)| params.iter().all(|p| table.iter().any(|t| t.0 == p.name)))
+            .map(|(_, f)| {
+                let model = Model::new(base.clone(), form);
+                data.conds
+                    .iter()
+                    .map(|c| channels::eval(&model, c, f))
+                    .collect()
+            });
         let stage = MfStage {
             form,
             base: base.clone(),
@@ -661,6 +724,7 @@ impl<'a> MfStage<'a> {
             channel,
             weights: None,
             analytic: None,
+            given,
             threads: 1,
         };
         Ok(stage.with_analytic(true))
@@ -705,6 +769,12 @@ impl<'a> MfStage<'a> {
     pub fn with_threads(mut self, threads: usize) -> Self {
         self.threads = threads.max(1);
         self
+    }
+
+    /// The known force of sample `i` ([`MfStage::given`]).
+    #[inline]
+    fn given(&self, i: usize) -> Option<f64> {
+        self.given.as_ref().map(|g| g[i])
     }
 
     /// The base parameters with θ written in.
@@ -797,6 +867,7 @@ struct DualRows<'s> {
     conds: &'s [Conditions],
     meas: &'s [f64],
     channel: Channel,
+    given: Option<&'s [f64]>,
 }
 
 impl DualRows<'_> {
@@ -812,7 +883,12 @@ impl DualRows<'_> {
     ) {
         for (k, rk) in r.iter_mut().enumerate() {
             let i = first + k;
-            let y = channels::eval(model, &self.conds[i], self.channel);
+            let y = channels::eval_given(
+                model,
+                &self.conds[i],
+                self.channel,
+                self.given.map(|g| g[i]),
+            );
             if col0 == 0 {
                 *rk = y.re - self.meas[i];
             }
@@ -859,7 +935,8 @@ impl Problem for MfStage<'_> {
         par_rows(self.threads, 0, r, None, &|first, r: &mut [f64], _| {
             for (k, rk) in r.iter_mut().enumerate() {
                 let i = first + k;
-                *rk = channels::eval(&model, &self.conds[i], self.channel) - self.meas[i];
+                *rk = channels::eval_given(&model, &self.conds[i], self.channel, self.given(i))
+                    - self.meas[i];
             }
         });
     }
@@ -929,6 +1006,7 @@ impl Problem for MfStage<'_> {
             conds: self.conds,
             meas: self.meas,
             channel: self.channel,
+            given: self.given.as_deref(),
         }))
     }
     fn threads(&self) -> usize {

@@ -758,12 +758,25 @@ impl<T: Real> Model<T> {
 
     /// See [`Model::fx_only`].
     pub(crate) fn mx_only(&self, c: &Conditions) -> T {
-        self.mx(c, self.load_pressure(c).1, self.fy_only(c))
+        self.mx_with_fy(c, self.fy_only(c))
     }
 
     /// See [`Model::fx_only`].
     pub(crate) fn my_only(&self, c: &Conditions) -> T {
-        self.my(c, self.fx_only(c))
+        self.my_with_fx(c, self.fx_only(c))
+    }
+
+    /// Mx given the combined-slip Fy ([`Model::fy_only`]'s value): the
+    /// fitter's Mx stage moves no Fy coefficient, so it computes Fy once per
+    /// sample instead of once per dual-number pass.
+    pub(crate) fn mx_with_fy(&self, c: &Conditions, fy: T) -> T {
+        self.mx(c, self.load_pressure(c).1, fy)
+    }
+
+    /// My given the combined-slip Fx ([`Model::fx_only`]'s value); see
+    /// [`Model::mx_with_fy`].
+    pub(crate) fn my_with_fx(&self, c: &Conditions, fx: T) -> T {
+        self.my(c, fx)
     }
 
     /// Normalised load and pressure change (4.E2a, 4.E2b), as in `pure`.

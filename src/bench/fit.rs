@@ -323,14 +323,7 @@ fn whole_fit(ctx: &super::BenchContext, dir: &std::path::Path) -> crate::Result<
     run.write_mat(&mat, false)?;
     let rec = crate::data::Recording::from_file(&mat)?;
     let opts = crate::fit::mf_fit::MfFitOptions::default();
-    let t0 = Instant::now();
-    let res = crate::fit::mf_fit::fit_mf(
-        std::slice::from_ref(&rec),
-        TyreParams::builtin(),
-        &opts,
-        None,
-    )?;
-    let secs = t0.elapsed().as_secs_f64();
+    let (res, secs) = timed_fit(&rec, &opts)?;
     let stages: Vec<String> = res
         .report
         .stages
@@ -355,40 +348,50 @@ fn whole_fit(ctx: &super::BenchContext, dir: &std::path::Path) -> crate::Result<
     devset_fit(&opts)
 }
 
-/// The whole staged fit of an independent dev-set recording of ≈ 100 000
-/// rows (`../shared/data/diagnose-dev/r05.dat.gz`, 'speed' programme, with
-/// `--holdout tail:0.3` as the dev-set test runs it), when present: the
-/// issue's speed goal is ≤ 10 s on this machine. No SciPy peer exists for a
-/// staged fit with validity rows and several starts; the pure-Fy figure
-/// above is the like-for-like comparison.
-fn devset_fit(opts: &crate::fit::mf_fit::MfFitOptions) -> crate::Result<()> {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/diagnose-dev/r05.dat.gz");
-    if !path.exists() {
-        println!(
-            "[fit] dev-set recording: skipped ({} absent)",
-            path.display()
-        );
-        return Ok(());
-    }
-    let loaded = crate::data::load(&path, &crate::data::LoadOptions::default())?;
-    let mut opts = opts.clone();
-    opts.holdout = crate::fit::Holdout::Tail { frac: 0.3 };
-    opts.t_origins = vec![loaded.report.warmup.as_ref().map(|w| w.t_start)];
-    let rec = loaded.recording;
+/// The staged fit of `rec` from the built-in tyre, and its wall time (s).
+fn timed_fit(
+    rec: &crate::data::Recording,
+    opts: &crate::fit::mf_fit::MfFitOptions,
+) -> crate::Result<(crate::fit::mf_fit::MfFit, f64)> {
     let t0 = Instant::now();
-    let res = crate::fit::mf_fit::fit_mf(
-        std::slice::from_ref(&rec),
-        TyreParams::builtin(),
-        &opts,
-        None,
-    )?;
-    println!(
-        "[fit] whole staged fit of dev-set r05 ({} samples, {} stages, tail:0.3), {} threads: {:.2} s (goal ≤ 10 s)",
-        rec.samples.len(),
-        res.report.stages.len(),
-        opts.threads,
-        t0.elapsed().as_secs_f64()
-    );
+    let res =
+        crate::fit::mf_fit::fit_mf(std::slice::from_ref(rec), TyreParams::builtin(), opts, None)?;
+    Ok((res, t0.elapsed().as_secs_f64()))
+}
+
+/// The whole staged fit of independent dev-set recordings, when present:
+/// `../shared/data/diagnose-dev/r05.dat.gz` (≈ 100 000 rows, 'speed'
+/// programme) and `r16.dat.gz` (84 000 rows, 'full' programme with the
+/// combined-slip drive/brake runs: the slowest of the 21 at 17 s before the
+/// race subsample and the moment stages' precomputed forces), with
+/// `--holdout tail:0.3` as the dev-set test runs them. The speed
+/// goal is ≤ 10 s on this machine. No SciPy peer exists for a staged fit
+/// with validity rows and several starts; the pure-Fy figure above is the
+/// like-for-like comparison.
+fn devset_fit(opts: &crate::fit::mf_fit::MfFitOptions) -> crate::Result<()> {
+    for (name, programme) in [("r05", "speed"), ("r16", "full")] {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join(format!("../shared/data/diagnose-dev/{name}.dat.gz"));
+        if !path.exists() {
+            println!(
+                "[fit] dev-set recording: skipped ({} absent)",
+                path.display()
+            );
+            return Ok(());
+        }
+        let loaded = crate::data::load(&path, &crate::data::LoadOptions::default())?;
+        let mut opts = opts.clone();
+        opts.holdout = crate::fit::Holdout::Tail { frac: 0.3 };
+        opts.t_origins = vec![loaded.report.warmup.as_ref().map(|w| w.t_start)];
+        let rec = loaded.recording;
+        let (res, secs) = timed_fit(&rec, &opts)?;
+        println!(
+            "[fit] whole staged fit of dev-set {name} ('{programme}' programme, {} samples, {} stages, tail:0.3), {} threads: {:.2} s (goal ≤ 10 s)",
+            rec.samples.len(),
+            res.report.stages.len(),
+            opts.threads,
+            secs
+        );
+    }
     Ok(())
 }

@@ -395,8 +395,11 @@ unsafe fn gram_add_avx2(
 
 /// Rows per chunk of the blocked linearisation ([`linearise_rows`]): fixed,
 /// not per thread, so the chunks' partial sums, added in chunk order, are
-/// the same whatever the thread count (bit-reproducible results).
-const CHUNK_ROWS: usize = 8192;
+/// the same whatever the thread count (bit-reproducible results). Small
+/// enough that the 3 000-sample start races of the num-dual stages
+/// (`mf_stages::RACE_SAMPLES`, ≈ 3 µs per Mz row) split over two cores;
+/// each chunk's partial JᵀJ (k × k) costs nothing beside its 2 048 rows.
+const CHUNK_ROWS: usize = 2048;
 /// Rows per Jacobian block within a chunk: a 128 × 30 block (30 kB) stays in
 /// L1 between being written and being multiplied.
 const BLOCK_ROWS: usize = 128;

@@ -478,10 +478,11 @@ pub fn fit_stage_from(
 pub const START_ITERATIONS: usize = 50;
 
 /// Several starts (issue #14 item 3): the problem's own and `extra`, each
-/// converged on the subsample `coarse` (to 1e-6; the [`RACE_SAMPLES`]
-/// subsample when the stage is large, the problem itself when it is not), judged by the full problem's cost — with a subsample
-/// that is the error on the (k − 1)/k samples the candidate was not fitted
-/// on, a held-out figure. Returns the best converged point.
+/// converged on the subsample `coarse` (to 1e-6; the [`RACE_SAMPLES`] or
+/// the [`COARSE_SAMPLES`] subsample when the stage is large, the problem
+/// itself when it is not), judged by the full problem's cost — with a
+/// subsample that is the error on the (k − 1)/k samples the candidate was
+/// not fitted on, a held-out figure. Returns the best converged point.
 fn best_start(
     problem: &dyn Problem,
     coarse: Option<&dyn Problem>,

@@ -280,8 +280,8 @@ pub fn fit_global(
     // start believed to be good), so it takes Gauss–Newton steps at once.
     let mut near = opts.clone();
     near.lm.lambda0 = near.lm.lambda0.min(1e-6);
-    // With `quick_polish`, a shorter stall window at the same rate per step: from a
-    // converged subsample the first Gauss–Newton steps take up the sampling
+    // With `quick_polish`, a shorter stall window at the same rate per
+    // step: from a converged subsample the first Gauss–Newton steps take up the sampling
     // difference, and what follows is the valley creep the stall rule
     // exists for; no later acceleration is to wait for (dev-set r19,
     // combined stage: 11 full-data steps, 6.5 of the fit's 17 s, lowered

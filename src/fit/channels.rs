@@ -33,7 +33,9 @@ pub fn eval<T: Real>(model: &Model<T>, c: &Conditions, channel: Channel) -> T {
 /// [`eval`] with the force the moment needs already known: `given` is
 /// Fy for [`Channel::Mx`] and Fx for [`Channel::My`] (their `f64` values
 /// at this sample, valid when no parameter that moves them carries a dual
-/// lane); ignored for the other channels. Same bits as [`eval`].
+/// lane); ignored for the other channels. In `f64` the same bits as
+/// [`eval`]; with dual lanes the same to rounding (the dual model's own Fy
+/// can differ from the `f64` one by ulps; `tests/fit_channels.rs`).
 #[inline]
 pub fn eval_given<T: Real>(
     model: &Model<T>,

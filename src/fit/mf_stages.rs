@@ -772,12 +772,6 @@ impl<'a> MfStage<'a> {
         self
     }
 
-    /// The known force of sample `i` ([`MfStage::given`]).
-    #[inline]
-    fn given(&self, i: usize) -> Option<f64> {
-        self.given.as_ref().map(|g| g[i])
-    }
-
     /// The base parameters with θ written in.
     pub fn params_at(&self, theta: &[f64]) -> MfParams<f64> {
         params_with(&self.base, &self.keys, theta)
@@ -933,11 +927,13 @@ impl Problem for MfStage<'_> {
             }
         }
         let model = Model::new(p, self.form);
+        let given = self.given.as_deref();
         par_rows(self.threads, 0, r, None, &|first, r: &mut [f64], _| {
             for (k, rk) in r.iter_mut().enumerate() {
                 let i = first + k;
-                *rk = channels::eval_given(&model, &self.conds[i], self.channel, self.given(i))
-                    - self.meas[i];
+                *rk =
+                    channels::eval_given(&model, &self.conds[i], self.channel, given.map(|g| g[i]))
+                        - self.meas[i];
             }
         });
     }

@@ -29,8 +29,8 @@
 
 use super::candidate::param::rerolled;
 use super::candidate::{
-    all, also_qualifying, channels_in_words, evaluate, select, why_not, Candidate, ChannelScore,
-    Evaluation,
+    all, also_qualifying, channels_in_words, evaluate, refit_on_all, select, why_not, Candidate,
+    ChannelScore, Evaluation,
 };
 use super::locate::{frictional_energy, locate, Finding, LocateOptions, Residuals};
 use super::slip_channel;
@@ -562,6 +562,13 @@ pub struct DiagnosisReport {
     pub candidates_implemented: Vec<&'static str>,
     /// The baseline against the data's noise floor ([`baseline_fit`]).
     pub baseline_fit: Vec<BaselineFit>,
+    /// The parameters written to `extended.tir`: the verdict's candidate
+    /// refitted on every segment after the selection
+    /// ([`crate::diagnose::candidate::refit_on_all`]); its entry in
+    /// `effects` holds the half fit that was scored. Absent without a
+    /// candidate verdict.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub extended_parameters: Option<BTreeMap<String, f64>>,
     /// The recorded slip ratio against the free-rolling radius
     /// ([`slip_channel::check`]); absent without an SR channel.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -675,6 +682,15 @@ pub fn diagnose_with(
     let slip_sim = match (&slip_ext, slip_verdict) {
         (Some(t), true) => Some(replay(&rerolled(rec, tyre, t, opts), t, opts)?.sim),
         _ => None,
+    };
+    // extended.tir: the verdict refitted on all segments once chosen
+    // ([`refit_on_all`]); the held-out figures below stay the half fit's.
+    let refit = match verdict_i {
+        Some(i) => match owned.iter().find(|c| c.name() == ev[i].0.name) {
+            Some(c) => Some(refit_on_all(rec, tyre, opts, c.as_ref())?),
+            None => None,
+        },
+        None => None,
     };
     let verdict = if slip_verdict {
         "rolling_radius".to_string()
@@ -810,10 +826,18 @@ pub fn diagnose_with(
         .iter()
         .map(|(ch, f)| (ch.key(), f.clone()))
         .collect();
-    let extended = match (&slip_ext, slip_verdict) {
-        (Some(t), true) => t.clone(),
+    let extended = match (&slip_ext, slip_verdict, &refit) {
+        (Some(t), true, _) => t.clone(),
+        (_, _, Some(r)) => r.tyre().clone(),
         _ => verdict_i.map_or_else(|| tyre.clone(), |i| ev[i].1.tyre().clone()),
     };
+    // The series the plots draw are what extended.tir does.
+    if let Some(r) = &refit {
+        extended_sim = r.predict(rec)?;
+    }
+    let extended_parameters = refit
+        .as_ref()
+        .map(|r| r.parameters().into_iter().collect::<BTreeMap<_, _>>());
     let report = DiagnosisReport {
         verdict: verdict.clone(),
         explanation: explanation.clone(),
@@ -828,6 +852,7 @@ pub fn diagnose_with(
         locate,
         candidates_implemented: owned.iter().map(|c| c.name()).collect(),
         baseline_fit: base_fit,
+        extended_parameters,
         slip_channel: slip,
         samples: rec.samples.len(),
         segments: rec.segments.len(),

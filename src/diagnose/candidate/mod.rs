@@ -72,6 +72,10 @@
 //!   BIC then prefers the fewer parameters between explanations that
 //!   generalise alike.
 //!
+//! * The file ([`refit_on_all`]): once named, the verdict's candidate is
+//!   fitted again on both halves for `extended.tir` (the half fit chose
+//!   it; all segments estimate it). The scores stay the half fit's.
+//!
 //! Must never: let a candidate see the held-out segments' forces while
 //! fitting (their inputs may drive a state), or panic on a recording with
 //! missing channels.
@@ -95,8 +99,8 @@ pub use selection::{
     also_qualifying, channels_in_words, qualifies, select, why_not, MAX_LOSS, MIN_GAIN,
 };
 pub use statistics::{
-    evaluate, fit_weights, held_out_sse, smoothed_inputs, split, ChannelScore, Evaluation,
-    DECORRELATION_TIME, SMOOTH_HALF_WIDTH,
+    evaluate, fit_weights, held_out_sse, refit_on_all, smoothed_inputs, split, ChannelScore,
+    Evaluation, DECORRELATION_TIME, SMOOTH_HALF_WIDTH,
 };
 
 use crate::data::Recording;

@@ -371,6 +371,33 @@ pub fn evaluate(
     Ok(out)
 }
 
+/// The named candidate refitted on every segment (both halves of
+/// [`split`]) once the selection is made: the held-out scores of
+/// [`evaluate`] choose the model, and its parameters are then estimated on
+/// all the data, as the baseline is. The rig's run-to-run scatter varies
+/// the forces segment by segment, so an estimate from half of the segments
+/// carries that scatter twice as strongly. Same inputs ([`smoothed_inputs`])
+/// and channel weights ([`fit_weights`], here over both halves) as the
+/// evaluation. Its predictions are in-sample throughout: the report's
+/// held-out figures stay those of the half fit.
+pub fn refit_on_all(
+    rec: &Recording,
+    baseline: &Tyre,
+    opts: &ReplayOptions,
+    candidate: &dyn Candidate,
+) -> Result<Box<dyn Fitted>> {
+    let smooth = smoothed_inputs(rec);
+    let (fit_mask, test_mask) = split(&smooth);
+    let all: Vec<bool> = fit_mask
+        .iter()
+        .zip(&test_mask)
+        .map(|(a, b)| *a || *b)
+        .collect();
+    let base = replay(&smooth, baseline, opts)?.sim;
+    let w = fit_weights(&smooth, &base, &all);
+    candidate.fit(&smooth, baseline, opts, &all, &w)
+}
+
 /// Held-out SSE of `sim` over Fx, Fy, Mz, each channel weighted by 1/its
 /// measured variance over both halves (halves of [`split`], offsets
 /// estimated on the fit half): a fixed yardstick for comparing models with

@@ -187,6 +187,12 @@ pub fn run(a: Args) -> Result<()> {
             100.0 * r.nrmse_after
         ));
     }
+    if let Some(w) = d.report.extended_parameters_in_words() {
+        m.say(format_args!(
+            "  extended.tir: {} refitted on every segment (the held-out figures above are the half fit's): {w}",
+            d.verdict
+        ));
+    }
     m.say(format_args!(
         "wrote {} ({} plots), {}, baseline.tir, extended.tir in {:.1} s",
         hp.display(),

@@ -123,7 +123,7 @@ figcaption{{font-size:.9em;color:#444}} details{{margin:1em 0}}\
             fy(&e.nrmse_after_held_out),
         );
     }
-    s.push_str("</table>\n<p><small>Held-out gain: share of the baseline's squared error (FX, FY, MZ, each over its variance) removed on the segments the candidate was not fitted on (the segments alternate between the halves within each group of kind and load); constant channel offsets are estimated on the fit half and removed. ΔBIC over the whole recording with an effective sample count of n/50 (rig channels are strongly autocorrelated): negative = the extra parameters pay for themselves.</small></p>\n");
+    s.push_str("</table>\n<p><small>Held-out gain: share of the baseline's squared error (FX, FY, MZ, each over its variance) removed on the segments the candidate was not fitted on (the segments alternate between the halves within each group of kind and load); constant channel offsets are estimated on the fit half and removed. ΔBIC over the whole recording with one effective sample per recorded second (residuals stay correlated over a sweep): negative = the extra parameters pay for themselves.</small></p>\n");
     // Locate.
     s.push_str("<h2>Where the residual concentrates (baseline)</h2>\n<p><small>Each grouping: a statistic, its permutation p-value (segment-level groupings permute segments; sample-level ones shift each segment's residual circularly, keeping its autocorrelation), Holm-adjusted over the groupings of the channel; significant rows highlighted (family-wise 5 %).</small></p>\n");
     for (ch, f) in &d.findings {
@@ -167,7 +167,15 @@ before = baseline, after = {} model; each model's constant channel offset (senso
             c = esc(&p.caption)
         );
     }
-    s.push_str("<p><small>Files: diagnosis.json (machine-readable), baseline.tir, extended.tir (load in the FMU or <code>tyrekit replay --tir</code>).</small></p>\n</body></html>\n");
+    s.push_str("<p><small>Files: diagnosis.json (machine-readable), baseline.tir, extended.tir (load in the FMU or <code>tyrekit replay --tir</code>).");
+    if let Some(w) = d.report.extended_parameters_in_words() {
+        let _ = write!(
+            s,
+            " extended.tir holds the verdict refitted on every segment once chosen (the table above shows the half fit that was scored): {}.",
+            esc(&w)
+        );
+    }
+    s.push_str("</small></p>\n</body></html>\n");
     s
 }
 

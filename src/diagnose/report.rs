@@ -584,6 +584,16 @@ pub struct DiagnosisReport {
 }
 
 impl DiagnosisReport {
+    /// `extended_parameters` as "K = v, …" (`None` without a candidate verdict).
+    pub fn extended_parameters_in_words(&self) -> Option<String> {
+        self.extended_parameters.as_ref().map(|ps| {
+            ps.iter()
+                .map(|(k, v)| format!("{k} = {v:.4}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        })
+    }
+
     /// As JSON (serialising plain data cannot fail; `Null` if it ever did).
     pub fn to_json(&self) -> Value {
         serde_json::to_value(self).unwrap_or(Value::Null)

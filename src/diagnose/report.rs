@@ -695,13 +695,15 @@ pub fn diagnose_with(
     };
     // extended.tir: the verdict refitted on all segments once chosen
     // ([`refit_on_all`]); the held-out figures below stay the half fit's.
-    let refit = match verdict_i {
-        Some(i) => match owned.iter().find(|c| c.name() == ev[i].0.name) {
-            Some(c) => Some(refit_on_all(rec, tyre, opts, c.as_ref())?),
-            None => None,
-        },
-        None => None,
-    };
+    // A refit that fails leaves the half fit in the file, and says so.
+    let mut refit_failed = None;
+    let refit = verdict_i
+        .and_then(|i| owned.iter().find(|c| c.name() == ev[i].0.name))
+        .and_then(|c| {
+            refit_on_all(rec, tyre, opts, c.as_ref())
+                .map_err(|e| refit_failed = Some(e.to_string()))
+                .ok()
+        });
     let verdict = if slip_verdict {
         "rolling_radius".to_string()
     } else {
@@ -798,6 +800,11 @@ pub fn diagnose_with(
                 left.join(", ")
             ));
         }
+    }
+    if let Some(e) = &refit_failed {
+        explanation.push_str(&format!(
+            " extended.tir holds the half fit scored above: its refit on every segment failed ({e})."
+        ));
     }
     if let Some(w) = &slip_words {
         explanation = if slip_verdict {

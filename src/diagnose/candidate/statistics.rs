@@ -271,11 +271,7 @@ pub fn evaluate(
     let smooth = smoothed_inputs(rec);
     let rec = &smooth;
     let (fit_mask, test_mask) = split(rec);
-    let all: Vec<bool> = fit_mask
-        .iter()
-        .zip(&test_mask)
-        .map(|(a, b)| *a || *b)
-        .collect();
+    let all = either(&fit_mask, &test_mask);
     // Per channel: (fit, test, all) SSE and counts, offsets from the fit half.
     let score = |sim: &[Forces]| {
         let o = offsets(rec, sim, &fit_mask);
@@ -371,6 +367,11 @@ pub fn evaluate(
     Ok(out)
 }
 
+/// The samples in either half: every segment of [`split`].
+fn either(fit: &[bool], test: &[bool]) -> Vec<bool> {
+    fit.iter().zip(test).map(|(a, b)| *a || *b).collect()
+}
+
 /// The named candidate refitted on every segment (both halves of
 /// [`split`]) once the selection is made: the held-out scores of
 /// [`evaluate`] choose the model, and its parameters are then estimated on
@@ -388,11 +389,7 @@ pub fn refit_on_all(
 ) -> Result<Box<dyn Fitted>> {
     let smooth = smoothed_inputs(rec);
     let (fit_mask, test_mask) = split(&smooth);
-    let all: Vec<bool> = fit_mask
-        .iter()
-        .zip(&test_mask)
-        .map(|(a, b)| *a || *b)
-        .collect();
+    let all = either(&fit_mask, &test_mask);
     let base = replay(&smooth, baseline, opts)?.sim;
     let w = fit_weights(&smooth, &base, &all);
     candidate.fit(&smooth, baseline, opts, &all, &w)
@@ -405,7 +402,7 @@ pub fn refit_on_all(
 /// scores each channel against the baseline's own error level instead.
 pub fn held_out_sse(rec: &Recording, sim: &[Forces]) -> f64 {
     let (fit, test) = split(rec);
-    let all: Vec<bool> = fit.iter().zip(&test).map(|(a, b)| *a || *b).collect();
+    let all = either(&fit, &test);
     let w = inverse_variances(rec, &all);
     weighted_sse(rec, sim, &test, &w, &offsets(rec, sim, &fit))
 }

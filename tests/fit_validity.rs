@@ -197,7 +197,7 @@ fn tyredata_fit_sigmas() -> Option<(Recording, f64, f64, f64)> {
 /// own σ uses the same metric, so a fit valid in 111 prints what the file
 /// gives).
 #[test]
-#[ignore = "not met: measured σ_Fy 4.47 %, σ_Mz 19.83 % in use mode 111 on 27 Nov (issue: ≤ 4 %, ≤ 15 %; σ_Mz 15 % lies below the steady floor 17.6 %, see tyredata_fit_is_near_the_steady_floor)"]
+#[ignore = "not met: measured σ_Fy 4.47 %, σ_Mz 19.83 % in use mode 111 on 27 Nov (issue: ≤ 4 %, ≤ 15 %; σ_Mz 15 % lies below the steady floor, 16.5 % with the in-sweep load, because the recorded Mz lags α by 0.125 s: see tyredata_mz_lags_the_slip_angle_which_no_steady_model_can_follow)"]
 fn tyredata_sigma_through_the_written_file_in_use_mode_111() {
     let Some((_, s_fy, s_mz, own)) = tyredata_fit_sigmas() else {
         return;
@@ -267,4 +267,101 @@ fn tyredata_fit_is_near_the_steady_floor() {
     );
     assert!(s_mz <= 1.2 * f_mz, "σ_Mz {s_mz} against the floor {f_mz}");
     assert!(s_fy <= 2.2 * f_fy, "σ_Fy {s_fy} against the floor {f_fy}");
+}
+
+/// Per-sweep least-squares floor σ of channel `ch` against a curve of the
+/// slip angle delayed by `lag` seconds, α(t − lag) (linear interpolation on
+/// the sweep's own samples, held at its ends), with the load variation
+/// inside the sweep as a second input: a degree-`deg` Chebyshev polynomial
+/// in α/0.25 rad (TyreData sweeps to ±0.229 rad) plus dFz times a cubic in
+/// it, dFz = Fz/mean(Fz) − 1 (the rig's load control lets Fz wander by
+/// 1–5 % in a sweep, which a curve of α alone would count as noise).
+fn lagged_floor(
+    rec: &Recording,
+    ch: fn(&tyrekit::data::Sample) -> f64,
+    lag: f64,
+    deg: usize,
+) -> f64 {
+    let (mut e, mut t) = (0.0, 0.0);
+    for g in rec
+        .segments
+        .iter()
+        .filter(|g| g.kind == tyrekit::data::SegmentKind::PureLateral)
+    {
+        let rows: Vec<_> = rec.samples[g.start..g.end]
+            .iter()
+            .filter(|s| ch(s).is_finite() && s.alpha.is_finite() && s.fz.is_finite())
+            .collect();
+        let alpha_at = |time: f64| -> f64 {
+            let k = rows.partition_point(|s| s.time <= time);
+            if k == 0 {
+                return rows[0].alpha;
+            }
+            if k == rows.len() {
+                return rows[k - 1].alpha;
+            }
+            let (a, b) = (rows[k - 1], rows[k]);
+            a.alpha + (b.alpha - a.alpha) * (time - a.time) / (b.time - a.time)
+        };
+        let fz_mean = rows.iter().map(|s| s.fz).sum::<f64>() / rows.len() as f64;
+        let cheb = |u: f64, k: usize| (k as f64 * u.clamp(-1.0, 1.0).acos()).cos();
+        let ncol = deg + 1 + 4;
+        assert!(rows.len() > 2 * ncol, "sweep of {} rows", rows.len());
+        let x = nalgebra::DMatrix::from_fn(rows.len(), ncol, |i, k| {
+            let u = alpha_at(rows[i].time - lag) / 0.25;
+            if k <= deg {
+                cheb(u, k)
+            } else {
+                (rows[i].fz / fz_mean - 1.0) * cheb(u, k - deg - 1)
+            }
+        });
+        let y = nalgebra::DVector::from_iterator(rows.len(), rows.iter().map(|s| ch(s)));
+        let c = x.clone().svd(true, true).solve(&y, 1e-12).unwrap();
+        e += (&x * c - &y).norm_squared();
+        t += y.norm_squared();
+    }
+    (e / t).sqrt()
+}
+
+/// Why σ_Mz ≤ 15 % is out of reach of any steady evaluation of TyreData
+/// (`tyrekit eval`, use mode 111, the issue's measure): the recorded Mz lags
+/// the recorded slip angle by about 0.12 s (0.6 of the 0.2 s sample, ≈ 2 m of
+/// rolling at 16.2 m/s — far beyond a relaxation length) while Fy does
+/// not. Per sweep, the best curve of α and the in-sweep load (degree 15, 900
+/// coefficients over the 45 sweeps against the MF's ~25 Mz coefficients),
+/// searched over delays of −0.1 … 0.3 s in steps of 0.025 s. Measured
+/// 28 Nov 2026: σ_Mz 16.5 % with α as recorded, 9.8 % with α delayed by
+/// 0.125 s; σ_Fy 1.73 %, best at zero delay. A steady model sees α(t) and
+/// Fz(t) only, so its σ_Mz is at least the zero-delay floor. Asserted: that
+/// floor above 15 %, the delayed one below 12 %, Fy's best delay within
+/// one grid step of zero and Mz's between 0.06 and 0.2 s.
+#[test]
+fn tyredata_mz_lags_the_slip_angle_which_no_steady_model_can_follow() {
+    let Some(rec) = tyredata() else {
+        return;
+    };
+    let lags: Vec<f64> = (-4..=12).map(|k| 0.0125 * k as f64 * 2.0).collect();
+    let best = |ch: fn(&tyrekit::data::Sample) -> f64| {
+        lags.iter()
+            .map(|&l| (l, lagged_floor(&rec, ch, l, 15)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap()
+    };
+    let (fy_lag, fy_best) = best(|s| s.fy);
+    let (mz_lag, mz_best) = best(|s| s.mz);
+    let mz_zero = lagged_floor(&rec, |s| s.mz, 0.0, 15);
+    let fy_zero = lagged_floor(&rec, |s| s.fy, 0.0, 15);
+    println!(
+        "TyreData per-sweep floor: σ_Fy {:.2} % at 0 s, best {:.2} % at {:.3} s; σ_Mz {:.2} % at 0 s, best {:.2} % at {:.3} s",
+        100.0 * fy_zero,
+        100.0 * fy_best,
+        fy_lag,
+        100.0 * mz_zero,
+        100.0 * mz_best,
+        mz_lag
+    );
+    assert!(mz_zero > 0.15, "zero-delay Mz floor {mz_zero}");
+    assert!(mz_best < 0.12, "delayed Mz floor {mz_best}");
+    assert!(fy_lag.abs() < 0.025, "Fy's best delay {fy_lag} s");
+    assert!((0.06..=0.2).contains(&mz_lag), "Mz's best delay {mz_lag} s");
 }

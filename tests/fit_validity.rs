@@ -197,7 +197,7 @@ fn tyredata_fit_sigmas() -> Option<(Recording, f64, f64, f64)> {
 /// own σ uses the same metric, so a fit valid in 111 prints what the file
 /// gives).
 #[test]
-#[ignore = "not met: measured σ_Fy 4.47 %, σ_Mz 19.83 % in use mode 111 on 27 Nov (issue: ≤ 4 %, ≤ 15 %; σ_Mz 15 % lies below the steady floor, 16.5 % with the in-sweep load, because the recorded Mz lags α by 0.125 s: see tyredata_mz_lags_the_slip_angle_which_no_steady_model_can_follow)"]
+#[ignore = "not met: measured σ_Fy 4.15 %, σ_Mz 20.06 % in use mode 111 on 28 Nov (issue: ≤ 4 %, ≤ 15 %; σ_Fy 4 % lies below the best valid MF 6.1 a global search found, 4.13 %, see tyredata_fit_reaches_the_best_valid_minimum_a_global_search_found; σ_Mz 15 % lies below the steady floor, 16.5 % with the in-sweep load, because the recorded Mz lags α by 0.125 s: see tyredata_mz_lags_the_slip_angle_which_no_steady_model_can_follow)"]
 fn tyredata_sigma_through_the_written_file_in_use_mode_111() {
     let Some((_, s_fy, s_mz, own)) = tyredata_fit_sigmas() else {
         return;
@@ -209,6 +209,40 @@ fn tyredata_sigma_through_the_written_file_in_use_mode_111() {
         (own - s_fy).abs() <= 1e-9,
         "fit printed σ_Fy {own}, the file gives {s_fy}"
     );
+}
+
+/// The best valid MF 6.1 pure-lateral fit of TyreData that a global search
+/// found (28 Nov 2026, an independent NumPy implementation checked against
+/// `tyrekit eval` to 2e-10: 62 random and informed starts, bounded least
+/// squares under a rising penalty, then SLSQP with the conditions imposed
+/// exactly — Ey ≤ 1 at every sample and both signs of αy, μy > 0, Kyα of one
+/// sign, PKY4 ≤ 5): σ_Fy 4.1287 %, reached from 17 starts; the next minima
+/// 4.21 %, 4.28 %, 4.30 %; without the Ey bound 3.80 %. So the issue's
+/// σ_Fy ≤ 4 % is below what a valid MF 6.1 reaches on these data, and a fit
+/// that keeps E ≤ 0.99 ([`tyrekit::fit::validity::MARGIN`]) may sit a little
+/// above the search's exact bound.
+const TYREDATA_BEST_VALID_SIGMA_FY: f64 = 0.041287;
+
+/// The fit reaches that best valid minimum (within 1 %: the validity
+/// margin), through the written file in use mode 111 — it stopped at 4.47 %
+/// before the penalty continuation
+/// ([`tyrekit::fit::mf_stages::CONTINUATION`]).
+#[test]
+fn tyredata_fit_reaches_the_best_valid_minimum_a_global_search_found() {
+    let Some((_, s_fy, _, own)) = tyredata_fit_sigmas() else {
+        return;
+    };
+    println!(
+        "TyreData σ_Fy {:.3} % (fit's own {:.3} %) against the global search's {:.3} %",
+        100.0 * s_fy,
+        100.0 * own,
+        100.0 * TYREDATA_BEST_VALID_SIGMA_FY
+    );
+    assert!(
+        s_fy <= 1.01 * TYREDATA_BEST_VALID_SIGMA_FY,
+        "σ_Fy {s_fy} against {TYREDATA_BEST_VALID_SIGMA_FY}"
+    );
+    assert!((own - s_fy).abs() <= 1e-9, "fit printed {own}, file {s_fy}");
 }
 
 /// The fit against the best any steady curve of α reaches per test

@@ -265,30 +265,8 @@ fn tyredata_fit_is_near_the_steady_floor() {
     let Some((rec, s_fy, s_mz, _)) = tyredata_fit_sigmas() else {
         return;
     };
-    let floor = |ch: fn(&tyrekit::data::Sample) -> f64| {
-        let (mut e, mut t) = (0.0, 0.0);
-        for g in rec
-            .segments
-            .iter()
-            .filter(|g| g.kind == tyrekit::data::SegmentKind::PureLateral)
-        {
-            let rows: Vec<_> = rec.samples[g.start..g.end]
-                .iter()
-                .filter(|s| ch(s).is_finite() && s.alpha.is_finite())
-                .collect();
-            const DEG: usize = 11;
-            assert!(rows.len() > 3 * (DEG + 1), "sweep of {} rows", rows.len());
-            let x = nalgebra::DMatrix::from_fn(rows.len(), DEG + 1, |i, k| {
-                let u = (rows[i].alpha / 0.2).clamp(-1.0, 1.0);
-                (k as f64 * u.acos()).cos()
-            });
-            let y = nalgebra::DVector::from_iterator(rows.len(), rows.iter().map(|s| ch(s)));
-            let c = x.clone().svd(true, true).solve(&y, 1e-12).unwrap();
-            e += (&x * c - &y).norm_squared();
-            t += y.norm_squared();
-        }
-        (e / t).sqrt()
-    };
+    // Degree 11 in α/0.2 rad (clamped at ±1), α as recorded, no load term.
+    let floor = |ch: fn(&tyrekit::data::Sample) -> f64| sweep_floor(&rec, ch, 0.0, 11, 0.2, false);
     let (f_fy, f_mz) = (floor(|s| s.fy), floor(|s| s.mz));
     println!(
         "TyreData steady floor σ_Fy {:.2} %, σ_Mz {:.2} %; the fitted file {:.2} % ({:.2}×), {:.2} % ({:.2}×)",
@@ -305,16 +283,18 @@ fn tyredata_fit_is_near_the_steady_floor() {
 
 /// Per-sweep least-squares floor σ of channel `ch` against a curve of the
 /// slip angle delayed by `lag` seconds, α(t − lag) (linear interpolation on
-/// the sweep's own samples, held at its ends), with the load variation
-/// inside the sweep as a second input: a degree-`deg` Chebyshev polynomial
-/// in α/0.25 rad (TyreData sweeps to ±0.229 rad) plus dFz times a cubic in
-/// it, dFz = Fz/mean(Fz) − 1 (the rig's load control lets Fz wander by
-/// 1–5 % in a sweep, which a curve of α alone would count as noise).
-fn lagged_floor(
+/// the sweep's own samples, held at its ends): a degree-`deg` Chebyshev
+/// polynomial in α/`scale` (clamped to ±1), and with `load` the load
+/// variation inside the sweep as a second input, dFz times a cubic in it,
+/// dFz = Fz/mean(Fz) − 1 (the rig's load control lets Fz wander by 1–5 % in
+/// a sweep, which a curve of α alone would count as noise).
+fn sweep_floor(
     rec: &Recording,
     ch: fn(&tyrekit::data::Sample) -> f64,
     lag: f64,
     deg: usize,
+    scale: f64,
+    load: bool,
 ) -> f64 {
     let (mut e, mut t) = (0.0, 0.0);
     for g in rec
@@ -339,10 +319,10 @@ fn lagged_floor(
         };
         let fz_mean = rows.iter().map(|s| s.fz).sum::<f64>() / rows.len() as f64;
         let cheb = |u: f64, k: usize| (k as f64 * u.clamp(-1.0, 1.0).acos()).cos();
-        let ncol = deg + 1 + 4;
+        let ncol = deg + 1 + if load { 4 } else { 0 };
         assert!(rows.len() > 2 * ncol, "sweep of {} rows", rows.len());
         let x = nalgebra::DMatrix::from_fn(rows.len(), ncol, |i, k| {
-            let u = alpha_at(rows[i].time - lag) / 0.25;
+            let u = alpha_at(rows[i].time - lag) / scale;
             if k <= deg {
                 cheb(u, k)
             } else {
@@ -377,14 +357,14 @@ fn tyredata_mz_lags_the_slip_angle_which_no_steady_model_can_follow() {
     let lags: Vec<f64> = (-4..=12).map(|k| 0.0125 * k as f64 * 2.0).collect();
     let best = |ch: fn(&tyrekit::data::Sample) -> f64| {
         lags.iter()
-            .map(|&l| (l, lagged_floor(&rec, ch, l, 15)))
+            .map(|&l| (l, sweep_floor(&rec, ch, l, 15, 0.25, true)))
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .unwrap()
     };
     let (fy_lag, fy_best) = best(|s| s.fy);
     let (mz_lag, mz_best) = best(|s| s.mz);
-    let mz_zero = lagged_floor(&rec, |s| s.mz, 0.0, 15);
-    let fy_zero = lagged_floor(&rec, |s| s.fy, 0.0, 15);
+    let mz_zero = sweep_floor(&rec, |s| s.mz, 0.0, 15, 0.25, true);
+    let fy_zero = sweep_floor(&rec, |s| s.fy, 0.0, 15, 0.25, true);
     println!(
         "TyreData per-sweep floor: σ_Fy {:.2} % at 0 s, best {:.2} % at {:.3} s; σ_Mz {:.2} % at 0 s, best {:.2} % at {:.3} s",
         100.0 * fy_zero,

@@ -454,7 +454,8 @@ pub fn fit_stage_from(
     } else {
         (&parts, &valid)
     };
-    let ladder: Vec<Stack> = if on_valid.as_ref().is_some_and(|v| v.n_residuals() > 0) {
+    let bound = !extra_starts.is_empty() && on_valid.as_ref().is_some_and(|v| v.n_residuals() > 0);
+    let ladder: Vec<Stack> = if bound {
         CONTINUATION
             .iter()
             .filter_map(|&f| stacked(on_parts, on_valid, f).transpose())

@@ -69,14 +69,16 @@ struct Outcome {
     seconds: f64,
 }
 
-/// (effect, gap channel, answer baseline, answer truth) of a recording.
-fn truth(dir: &Path, name: &str) -> (String, String, f64, f64) {
+/// A recording's answer: its effect and, per pure-slip channel, (channel,
+/// answer baseline, answer truth).
+fn answer_of(dir: &Path, name: &str) -> (String, Vec<(String, f64, f64)>) {
     let text = std::fs::read_to_string(dir.join("answers.json")).expect("answers.json");
     let v: serde_json::Value = serde_json::from_str(&text).expect("JSON");
     let a = &v["recordings"][name];
     let effect = a["effect"].as_str().expect("effect").to_string();
-    let pure = a["nrmse_last30"]["pure"].as_object().expect("pure group");
-    let (ch, b, t) = pure
+    let pure = a["nrmse_last30"]["pure"]
+        .as_object()
+        .expect("pure group")
         .iter()
         .map(|(c, f)| {
             (
@@ -85,21 +87,17 @@ fn truth(dir: &Path, name: &str) -> (String, String, f64, f64) {
                 f["truth"].as_f64().expect("truth"),
             )
         })
-        .max_by(|x, y| (x.1 - x.2).total_cmp(&(y.1 - y.2)))
-        .expect("a pure-slip channel");
-    (effect, ch, b, t)
+        .collect();
+    (effect, pure)
 }
 
-/// (channel, answer truth) of every pure-slip channel of a recording.
-fn pure_truths(dir: &Path, name: &str) -> Vec<(String, f64)> {
-    let text = std::fs::read_to_string(dir.join("answers.json")).expect("answers.json");
-    let v: serde_json::Value = serde_json::from_str(&text).expect("JSON");
-    v["recordings"][name]["nrmse_last30"]["pure"]
-        .as_object()
-        .expect("pure group")
-        .iter()
-        .map(|(c, f)| (c.clone(), f["truth"].as_f64().expect("truth")))
-        .collect()
+/// The gap channel of pure-slip answers: (channel, answer baseline, answer
+/// truth) with the largest baseline − truth.
+fn gap_channel(pure: &[(String, f64, f64)]) -> (String, f64, f64) {
+    pure.iter()
+        .max_by(|x, y| (x.1 - x.2).total_cmp(&(y.1 - y.2)))
+        .cloned()
+        .expect("a pure-slip channel")
 }
 
 /// The share of the gap an extension can recover at best if it brings the
@@ -160,7 +158,8 @@ fn run(a: &Answer, dir: &Path, data: &Path) -> Outcome {
     )
     .expect("diagnosis.json is JSON");
     let verdict = j["verdict"].as_str().expect("verdict").to_string();
-    let (effect, channel, ab, at) = truth(data, &a.name);
+    let (effect, pure) = answer_of(data, &a.name);
+    let (channel, ab, at) = gap_channel(&pure);
     let raw = devset::read_raw(&a.file);
     let gap_nrmse = |sim: &Path| {
         let (figs, _) = devset::figures(a, &raw, &devset::read_sim(sim));
@@ -188,12 +187,12 @@ fn run(a: &Answer, dir: &Path, data: &Path) -> Outcome {
     }
     let (base_figs, _) =
         devset::figures(a, &raw, &devset::read_sim(&report.join("baseline_sim.csv")));
-    let to_truth = pure_truths(data, &a.name)
-        .into_iter()
-        .filter_map(|(c, t)| {
+    let to_truth = pure
+        .iter()
+        .filter_map(|(c, _, t)| {
             base_figs
                 .iter()
-                .find(|x| x.group == "pure" && x.channel == c)
+                .find(|x| x.group == "pure" && x.channel == *c)
                 .map(|x| (c.clone(), x.ours / t))
         })
         .collect();
@@ -238,13 +237,7 @@ fn summary(v: &[Outcome]) -> (usize, usize, usize, usize, f64) {
     let effects: Vec<&Outcome> = v.iter().filter(|o| o.effect != "none").collect();
     let controls: Vec<&Outcome> = v.iter().filter(|o| o.effect == "none").collect();
     let named: Vec<&&Outcome> = effects.iter().filter(|o| o.verdict == o.effect).collect();
-    let median = median(
-        named
-            .iter()
-            .map(|o| o.recovered)
-            .filter(|g| g.is_finite())
-            .collect(),
-    );
+    let median = median(named.iter().map(|o| o.recovered).collect());
     (
         named.len(),
         effects.len(),

@@ -520,5 +520,7 @@ pub(crate) fn step(c: &StepCtx, p: &LuGreParams, st: &mut TransientState, dt: f6
         vsy: c.kin.vsy,
         sigma_x: c.props.sigma_x,
         sigma_y: c.props.sigma_y,
+        friction_scale: c.s,
+        stiffness_scale: c.c,
     }
 }

@@ -190,6 +190,12 @@ pub struct WheelOutput {
     pub sigma_x: f64,
     /// Lateral relaxation length in use (m).
     pub sigma_y: f64,
+    /// Friction scale `s` of the similarity method this step used (the
+    /// `mu_scale` input times the tyre file's extension, see
+    /// [`extension`]; 1 for a plain MF): the forces are s·F(c·κ/s, …).
+    pub friction_scale: f64,
+    /// Slip-stiffness scale `c` of the same step (1 for a plain MF).
+    pub stiffness_scale: f64,
 }
 
 /// Number of `f64` state slots of any transient model (fixed so FMU states serialise simply).
@@ -943,6 +949,8 @@ impl TransientModel {
                 vsy: kin.vsy,
                 sigma_x: props.sigma_x,
                 sigma_y: props.sigma_y,
+                friction_scale: s,
+                stiffness_scale: c,
                 ..Default::default()
             }
         } else if steady {
@@ -1023,6 +1031,8 @@ impl TransientModel {
             vsy: c.kin.vsy,
             sigma_x: c.props.sigma_x,
             sigma_y: c.props.sigma_y,
+            friction_scale: c.s,
+            stiffness_scale: c.c,
         }
     }
 }

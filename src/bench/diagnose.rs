@@ -15,7 +15,8 @@
 
 use crate::diagnose::baseline::{drop_unfitted, fit_baseline};
 use crate::diagnose::locate::frictional_energy;
-use crate::diagnose::report::{diagnose, locate_channel};
+use crate::diagnose::reestimate::{refit_fitted_baseline, RefitBaseline};
+use crate::diagnose::report::{diagnose_with, locate_channel};
 use crate::diagnose::{html, plots};
 use crate::mf::Tyre;
 use crate::residual::{replay, Channel, ReplayOptions};
@@ -87,7 +88,14 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
     let fitted = Tyre::new(b.tyre)?;
     let rec = &recs[0];
     let t0 = Instant::now();
-    let d = diagnose(rec, &fitted, &ReplayOptions::default())?;
+    let refit = refit_fitted_baseline(threads);
+    let d = diagnose_with(
+        rec,
+        &fitted,
+        &ReplayOptions::default(),
+        Some(&refit as &RefitBaseline),
+        &mut |_| {},
+    )?;
     let t_diag = t0.elapsed().as_secs_f64();
     let t0 = Instant::now();
     let pl = plots::draw_all(rec, &d, &dir)?;

@@ -237,6 +237,7 @@ fn workflow(args: &Args, out: &Path) -> Result<()> {
         report: report.clone(),
         tir: None,
         read: Default::default(),
+        keep_baseline: false,
     })?;
     let jp = report.join("diagnosis.json");
     let text = std::fs::read_to_string(&jp).map_err(|e| Error::io(&jp, e))?;

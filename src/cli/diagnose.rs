@@ -11,6 +11,7 @@
 
 use crate::data::ReChoice;
 use crate::diagnose::baseline::{drop_unfitted, fit_baseline, HELD_PRESSURE_KEYS};
+use crate::diagnose::reestimate::{refit_fitted_baseline, RefitBaseline};
 use crate::diagnose::report::{diagnose_with, merge};
 use crate::diagnose::{html, plots};
 use crate::fit::Progress;
@@ -42,6 +43,11 @@ pub struct Args {
     /// load-dependent κ bias of its own.
     #[command(flatten)]
     pub read: crate::cli::data::RecordingArgs,
+    /// Write extended.tir as the fitted baseline plus the extension only:
+    /// do not fit the baseline's Magic Formula again beneath a named
+    /// extension (see the README, "re-estimation"). Without --tir only.
+    #[arg(long)]
+    pub keep_baseline: bool,
 }
 
 fn bar(m: &super::manners::Manners, len: u64, template: &str) -> Option<ProgressBar> {
@@ -138,7 +144,7 @@ pub fn run(a: Args) -> Result<()> {
     let m = &a.manners;
     m.say(&note);
     let rec = merge(recs);
-    let steps = bar(m, 3, "{prefix:>12} [{bar:30}] {pos}/{len} {msg} {elapsed}");
+    let steps = bar(m, 4, "{prefix:>12} [{bar:30}] {pos}/{len} {msg} {elapsed}");
     if let Some(b) = &steps {
         b.set_prefix("diagnose");
     }
@@ -150,7 +156,17 @@ pub fn run(a: Args) -> Result<()> {
             b.set_message(s.to_string());
         }
     };
-    let d = diagnose_with(&rec, &tyre, &ReplayOptions::default(), &mut step)?;
+    // Without --tir the diagnosis fitted the baseline, and fits it again
+    // beneath a named extension for extended.tir (diagnose::reestimate).
+    let threads = a.manners.threads();
+    let refit = refit_fitted_baseline(threads);
+    let d = diagnose_with(
+        &rec,
+        &tyre,
+        &ReplayOptions::default(),
+        (a.tir.is_none() && !a.keep_baseline).then_some(&refit as &RefitBaseline),
+        &mut step,
+    )?;
     let mut base = tyre.params().clone();
     prov.stamp(&mut base);
     base.write(&a.report.join("baseline.tir"))?;

@@ -186,6 +186,21 @@ pub fn fit_baseline(
     threads: usize,
     progress: Option<&mut ProgressFn>,
 ) -> Result<Baseline> {
+    fit_baseline_from(recs, None, None, threads, progress)
+}
+
+/// [`fit_baseline`] from `start` instead of the built-in tyre (None: the
+/// built-in one) and, given `stages`, only those; the same held keys,
+/// options and thinning otherwise. The re-estimation
+/// ([`crate::diagnose::reestimate`]) fits the baseline again from the
+/// previous one on samples seen through a named extension.
+pub fn fit_baseline_from(
+    recs: &[Recording],
+    from: Option<TyreParams>,
+    stages: Option<&[StageKind]>,
+    threads: usize,
+    progress: Option<&mut ProgressFn>,
+) -> Result<Baseline> {
     let n: usize = recs.iter().map(|r| r.samples.len()).sum();
     let stride = n.div_ceil(MAX_FIT_SAMPLES).max(1);
     let p_med = median(
@@ -211,7 +226,7 @@ pub fn fit_baseline(
             d
         })
         .collect();
-    let mut start = TyreParams::builtin();
+    let mut start = from.unwrap_or_else(TyreParams::builtin);
     for k in HELD_PRESSURE_KEYS {
         start.set(k, 0.0)?;
     }
@@ -232,6 +247,9 @@ pub fn fit_baseline(
     // in a worse minimum of this baseline (held-out σ_Fy 11.7 % against
     // 4.7 %), which an in-sample criterion over Fy and Mz did not catch.
     opts.fit.lm.lambda0 = 1e-3;
+    if let Some(only) = stages {
+        opts.only = only.to_vec();
+    }
     let mut fit = fit_mf(&data, start, &opts, progress)?;
     widen_pressure_range(&mut fit.tyre, recs)?;
     Ok(Baseline {

@@ -4,7 +4,8 @@
 //! each grouping ([`locate`]), fit the baseline when none is given
 //! ([`baseline`]), name, model and fit the physics left out ([`candidate`];
 //! a rolling radius the forces cannot show, from the recorded slip ratio
-//! against the free-rolling radius: [`slip_channel`]),
+//! against the free-rolling radius: [`slip_channel`]), fit a fitted
+//! baseline again beneath the named extension for the file ([`reestimate`]),
 //! explain and score it ([`report`]) and draw it ([`plots`], [`html`]).
 //!
 //! Must never: judge structure without a significance (noise must not look
@@ -18,6 +19,7 @@ pub mod factor;
 pub mod html;
 pub mod locate;
 pub mod plots;
+pub mod reestimate;
 /// The residual stage's replay, kept at its former path for callers
 /// ([`crate::residual`] is its home).
 pub mod replay {

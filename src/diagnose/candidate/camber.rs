@@ -55,5 +55,6 @@ pub(super) fn candidate() -> ParamCandidate {
                 .collect::<Vec<_>>()
                 .join(", ")
         },
+        reestimable: false,
     }
 }

@@ -156,5 +156,6 @@ pub(super) fn candidate() -> ParamCandidate {
         n: 2 * KNOTS,
         spec: load_spec,
         words,
+        reestimable: true,
     }
 }

@@ -67,5 +67,6 @@ pub(super) fn candidate() -> ParamCandidate {
                 param(f, "MUS")
             )
         },
+        reestimable: false,
     }
 }

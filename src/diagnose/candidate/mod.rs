@@ -74,7 +74,10 @@
 //!
 //! * The file ([`refit_on_all`]): once named, the verdict's candidate is
 //!   fitted again on both halves for `extended.tir` (the half fit chose
-//!   it; all segments estimate it). The scores stay the half fit's.
+//!   it; all segments estimate it). The scores stay the half fit's. When
+//!   the diagnosis fitted the baseline itself, a candidate that acts
+//!   through slips and similarity scales ([`Candidate::reestimable`]) then
+//!   has the baseline fitted again beneath it ([`crate::diagnose::reestimate`]).
 //!
 //! Must never: let a candidate see the held-out segments' forces while
 //! fitting (their inputs may drive a state), or panic on a recording with
@@ -107,6 +110,7 @@ use crate::data::Recording;
 use crate::error::Result;
 use crate::mf::{Forces, Tyre};
 use crate::residual::ReplayOptions;
+use crate::transient::WheelOutput;
 
 /// A fitted extension: its parameters and its predictions.
 pub trait Fitted: Send + Sync {
@@ -114,6 +118,12 @@ pub trait Fitted: Send + Sync {
     fn parameters(&self) -> Vec<(String, f64)>;
     /// Simulated forces for every sample of `rec`.
     fn predict(&self, rec: &Recording) -> Result<Vec<Forces>>;
+    /// The full step outputs behind [`Fitted::predict`] (the slips the
+    /// force model used, the similarity scales), one per sample; None
+    /// where the prediction is not a plain replay of [`Fitted::tyre`].
+    fn outputs(&self, _rec: &Recording) -> Result<Option<Vec<WheelOutput>>> {
+        Ok(None)
+    }
     /// The extended tyre to write as `extended.tir`.
     fn tyre(&self) -> &Tyre;
     /// Fitted parameters that ended at a bound of their range, in words
@@ -138,6 +148,12 @@ pub trait Candidate: Send + Sync {
     /// ("transient slip lag"): used in the explanation of a verdict.
     fn physics(&self) -> &'static str {
         self.name()
+    }
+    /// Whether the extension acts only through the step's slips and
+    /// similarity scales, so that the baseline can be fitted again beneath
+    /// it ([`crate::diagnose::reestimate`]).
+    fn reestimable(&self) -> bool {
+        false
     }
     /// The fitted extension in words with its key parameter(s), e.g.
     /// "a relaxation length of 0.31 m (×1.2 the file's)".

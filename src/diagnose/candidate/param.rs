@@ -16,7 +16,7 @@ use crate::mf::{Forces, MfInput, Tyre};
 use crate::residual::{mf_input, replay, Channel, ReplayOptions};
 use crate::tir::MfVersion;
 use crate::transient::extension::set_file_transient;
-use crate::transient::{LuGreParams, TransientKind};
+use crate::transient::{LuGreParams, TransientKind, WheelOutput};
 
 /// Most fit-half samples a static candidate is fitted on.
 pub const STATIC_SAMPLES: usize = 4000;
@@ -82,6 +82,12 @@ impl Fitted for Model {
     }
     fn predict(&self, rec: &Recording) -> Result<Vec<Forces>> {
         self.sim(rec)
+    }
+    fn outputs(&self, rec: &Recording) -> Result<Option<Vec<WheelOutput>>> {
+        if self.kappa_re {
+            return Ok(None);
+        }
+        Ok(Some(replay(rec, &self.tyre, &self.opts)?.out))
     }
     fn tyre(&self) -> &Tyre {
         &self.tyre
@@ -561,6 +567,8 @@ pub struct ParamCandidate {
     pub n: usize,
     pub spec: fn(&Tyre, &ReplayOptions) -> Option<Spec>,
     pub words: fn(&dyn Fitted) -> String,
+    /// See [`Candidate::reestimable`].
+    pub reestimable: bool,
 }
 
 /// Fit-half sample indices, thinned to at most `max` (evenly).
@@ -579,6 +587,9 @@ impl Candidate for ParamCandidate {
     }
     fn physics(&self) -> &'static str {
         self.physics
+    }
+    fn reestimable(&self) -> bool {
+        self.reestimable
     }
     fn describe(&self, f: &dyn Fitted) -> String {
         let held = f.held();

@@ -84,5 +84,6 @@ pub(super) fn candidate() -> ParamCandidate {
         n: TERMS.len(),
         spec: pressure_spec,
         words,
+        reestimable: false,
     }
 }

@@ -51,5 +51,6 @@ pub(super) fn candidate() -> ParamCandidate {
                 o.sigmay, o.sigmax
             )
         },
+        reestimable: true,
     }
 }

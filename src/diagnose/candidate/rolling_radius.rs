@@ -45,5 +45,6 @@ pub(super) fn candidate() -> ParamCandidate {
                 param(f, "FREFF")
             )
         },
+        reestimable: false,
     }
 }

@@ -130,5 +130,6 @@ pub(super) fn candidate() -> ParamCandidate {
                 l.vref
             )
         },
+        reestimable: true,
     }
 }

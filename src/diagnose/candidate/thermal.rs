@@ -90,6 +90,7 @@ pub(super) fn candidate() -> ParamCandidate {
                 m(1.0)
             )
         },
+        reestimable: true,
     }
 }
 

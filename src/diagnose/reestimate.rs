@@ -1,0 +1,297 @@
+//! reestimate — once the diagnosis has named an extension, the baseline's
+//! Magic Formula fitted again beneath it, for `extended.tir`.
+//!
+//! The baseline was fitted to data that contain the missing physics, so its
+//! MF parameters absorbed part of it: a slip stiffness that grows with load
+//! faster than the MF's form allows ends as a compromise of PKY1, PKY2 and
+//! the curvature factors, a friction that fades with temperature as a mean
+//! friction level. An extension fitted on top of that baseline can only
+//! correct what the compromise left. Alternating the two fits — block
+//! coordinate descent on the joint model — lets the MF take back the shape
+//! the data show once the extension carries its share:
+//!
+//! 1. replay the extended tyre; per sample take the slips its force model
+//!    used (κ′, α′: lagged for a relaxation finding) and the similarity
+//!    scales of the step, s and c ([`WheelOutput::friction_scale`],
+//!    [`WheelOutput::stiffness_scale`]): the step's forces are
+//!    s·F(c·κ′/s, atan(c·tan α′/s)) (Pacejka, *Tyre and Vehicle Dynamics*,
+//!    3rd ed., §4.3.2), Mz also × m, the load curve's moment scale;
+//! 2. the recording seen through them — κ ← c·κ′/s, tan α ← c·tan α′/s,
+//!    Fx, Fy, Mx ← ·/s, Mz ← Mz/(s·m) — is what the plain MF must fit; fit
+//!    the baseline again on it from the previous one
+//!    ([`super::baseline::fit_baseline_from`], through the caller's
+//!    [`RefitBaseline`]);
+//! 3. refit the extension on the new baseline ([`refit_on_all`]).
+//!
+//! Up to [`ROUNDS`] rounds (fewer once a round gains less than
+//! [`MIN_ROUND_GAIN`]); a round is kept only when it lowers the extended
+//! tyre's in-sample error (every segment, each channel weighted by 1/the
+//! baseline's mean squared residual as in the candidates' fits, constant
+//! offsets removed) and no channel's own error rises by more than the
+//! selection allows a named effect ([`MAX_LOSS`]), so the file is never
+//! worse than the plain refit on the data it was fitted to.
+//!
+//! Only for candidates that act through slips and similarity scales alone
+//! ([`Candidate::reestimable`]: load sensitivity, speed friction, thermal,
+//! relaxation), and only when the diagnosis fitted its baseline itself: a
+//! baseline given with `--tir` is the user's tyre and stays.
+//!
+//! Must never: change the verdict, the held-out scores or `baseline.tir`
+//! (they are the baseline's, fitted without any extension), or return a
+//! file whose in-sample error is higher than the plain refit's.
+
+use super::candidate::{fit_weights, refit_on_all, split, Candidate, Fitted, MAX_LOSS};
+use crate::data::Recording;
+use crate::error::Result;
+use crate::fit::mf_stages::StageKind;
+use crate::mf::{Forces, Tyre};
+use crate::residual::{channel_sse, offsets, replay, weighted_sse, ReplayOptions};
+use crate::tir::TyreParams;
+use crate::transient::WheelOutput;
+
+/// Most alternations of the MF fit and the extension's refit. Dev set
+/// (in-sample error per round): r12 −5.2, −3.3, −0.8, −0.006 %; r14 −10.6,
+/// −0.3, −0.06 %; r19 −0.4, −0.1, −0.1 %: the third round takes nearly all
+/// that is left.
+pub const ROUNDS: usize = 3;
+
+/// A round that lowers the in-sample error by less than this fraction ends
+/// the alternation (it is still kept).
+pub const MIN_ROUND_GAIN: f64 = 1e-3;
+
+/// The stages fitted again: the pure-slip curves and the aligning moment,
+/// which the named physics reshapes. The combined-slip stage keeps the
+/// baseline's values: refitted on the samples seen through the extension it
+/// moved the κ-induced side force S_Vyκ (Pacejka, *Tyre and Vehicle
+/// Dynamics*, 3rd ed., eqs. 4.E67–4.E68) far — RVY1 0.0016 → 0.033 on dev
+/// r17, 0.046 → 0 on r12 — and the side force of the drive/brake runs at
+/// α ≈ 0, which no stage fits, came out 1.2–2× the baseline's error; its
+/// gate also refits the pure stages once more, which the rounds here do.
+pub const REESTIMATED_STAGES: [StageKind; 3] =
+    [StageKind::PureFx, StageKind::PureFy, StageKind::Mz];
+
+/// Fits the baseline again: (the recording as the plain MF must see it,
+/// the previous baseline to start from) → the new baseline.
+pub type RefitBaseline<'a> = dyn Fn(&Recording, &TyreParams) -> Result<TyreParams> + Sync + 'a;
+
+/// The [`RefitBaseline`] of a baseline the diagnosis fitted itself
+/// ([`super::baseline::fit_baseline`]): the same fit from the previous
+/// baseline, [`REESTIMATED_STAGES`] only.
+pub fn refit_fitted_baseline(
+    threads: usize,
+) -> impl Fn(&Recording, &TyreParams) -> Result<TyreParams> + Sync {
+    move |r, start| {
+        super::baseline::fit_baseline_from(
+            std::slice::from_ref(r),
+            Some(start.clone()),
+            Some(&REESTIMATED_STAGES),
+            threads,
+            None,
+        )
+        .map(|b| b.tyre)
+    }
+}
+
+/// What [`reestimate`] returns.
+pub struct Reestimated {
+    /// The extension on the re-estimated baseline (or the plain refit when
+    /// no round lowered the error).
+    pub fitted: Box<dyn Fitted>,
+    /// Rounds kept (0: the plain refit).
+    pub rounds: usize,
+    /// In-sample weighted error of the plain refit and of the result.
+    pub cost_plain: f64,
+    pub cost: f64,
+}
+
+/// The recording as the plain MF must see it for `tyre`'s extension to
+/// reproduce `rec` (step 2 of the module docs), from the step outputs `out`
+/// of a replay of `tyre`. A sample whose step failed keeps its inputs and
+/// loses its forces (NaN: no stage fits it).
+pub fn through_extension(rec: &Recording, tyre: &Tyre, out: &[WheelOutput]) -> Recording {
+    let mut r = rec.clone();
+    let ext = tyre.extension();
+    for (s, o) in r.samples.iter_mut().zip(out) {
+        let (sc, cc) = (o.friction_scale, o.stiffness_scale);
+        let ok = o.fx.is_finite()
+            && sc.is_finite()
+            && sc > 0.0
+            && cc.is_finite()
+            && cc > 0.0
+            && o.kappa.is_finite()
+            && o.alpha.is_finite();
+        if !ok {
+            s.fx = f64::NAN;
+            s.fy = f64::NAN;
+            s.mx = f64::NAN;
+            s.mz = f64::NAN;
+            continue;
+        }
+        let m = ext.map_or(1.0, |e| e.moment_scale(s.fz));
+        let k = cc / sc;
+        // The step reports κ in the MF's convention (the sign of Vx).
+        let dir = if s.vx < 0.0 { -1.0 } else { 1.0 };
+        s.kappa = dir * o.kappa * k;
+        s.alpha = (o.alpha.tan() * k).atan();
+        s.fx /= sc;
+        s.fy /= sc;
+        s.mx /= sc;
+        s.mz /= sc * m;
+    }
+    r
+}
+
+/// In-sample error of `sim` on every segment of `rec`: (the sum with
+/// channel weights `w`, each channel's own SSE), constant offsets removed.
+fn cost(rec: &Recording, sim: &[Forces], all: &[bool], w: &[f64; 3]) -> (f64, [f64; 3]) {
+    let o = offsets(rec, sim, all);
+    let per = channel_sse(rec, sim, all, &o).map(|(e, _)| e);
+    (weighted_sse(rec, sim, all, w, &o), per)
+}
+
+/// Alternate the baseline's MF fit and the extension's refit (see the
+/// module docs), starting from `plain`, the extension refitted on
+/// `baseline` ([`refit_on_all`]).
+pub fn reestimate(
+    rec: &Recording,
+    baseline: &Tyre,
+    opts: &ReplayOptions,
+    candidate: &dyn Candidate,
+    plain: Box<dyn Fitted>,
+    refit: &RefitBaseline,
+) -> Result<Reestimated> {
+    let (fit_mask, test_mask) = split(rec);
+    let all: Vec<bool> = fit_mask
+        .iter()
+        .zip(&test_mask)
+        .map(|(a, b)| *a || *b)
+        .collect();
+    let base_sim = replay(rec, baseline, opts)?.sim;
+    let w = fit_weights(rec, &base_sim, &all);
+    let (cost_plain, per_plain) = cost(rec, &plain.predict(rec)?, &all, &w);
+    let mut best = Reestimated {
+        fitted: plain,
+        rounds: 0,
+        cost_plain,
+        cost: cost_plain,
+    };
+    if !candidate.reestimable() || !cost_plain.is_finite() {
+        return Ok(best);
+    }
+    let mut mf = baseline.params().clone();
+    for round in 1..=ROUNDS {
+        let Some(out) = best.fitted.outputs(rec)? else {
+            break;
+        };
+        let seen = through_extension(rec, best.fitted.tyre(), &out);
+        mf = refit(&seen, &mf)?;
+        let next = refit_on_all(rec, &Tyre::new(mf.clone())?, opts, candidate)?;
+        let (c, per) = cost(rec, &next.predict(rec)?, &all, &w);
+        // Kept when the error falls and no channel's rises beyond what the
+        // selection allows a named effect ([`MAX_LOSS`]).
+        let worse = per
+            .iter()
+            .zip(&per_plain)
+            .any(|(a, b)| a.is_nan() || *a > (1.0 + MAX_LOSS) * b);
+        if c.is_nan() || c >= best.cost || worse {
+            break;
+        }
+        let gain = 1.0 - c / best.cost;
+        best = Reestimated {
+            fitted: next,
+            rounds: round,
+            cost_plain,
+            cost: c,
+        };
+        if gain < MIN_ROUND_GAIN {
+            break;
+        }
+    }
+    Ok(best)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::Sample;
+    use crate::mf::UseMode;
+    use crate::transient::{InputMode, TransientConfig, TransientKind, TransientModel};
+
+    /// Step 2 inverts the similarity method: the plain MF at the samples
+    /// seen through a load curve gives the extended tyre's forces divided
+    /// by s (Fx, Fy) — checked on a tyre whose load curve raises friction
+    /// 10 % and stiffness 20 % at the high load, at a combined-slip point.
+    #[test]
+    fn the_transformed_samples_make_the_plain_mf_reproduce_the_extension() {
+        let plain = Tyre::builtin();
+        let mut p = plain.params().clone();
+        let s = p.extra_section(crate::transient::extension::LOAD_SECTION);
+        for (k, v) in [
+            ("FZ1", 2000.0),
+            ("FZ2", 6000.0),
+            ("MU_FZ1", 0.0),
+            ("MU_FZ2", 0.1),
+            ("K_FZ1", 0.0),
+            ("K_FZ2", 0.2),
+        ] {
+            s.set(k, v);
+        }
+        let ext = Tyre::new(p).unwrap();
+        let sample = Sample {
+            time: 0.0,
+            vx: 20.0,
+            omega: f64::NAN,
+            fz: 6000.0,
+            kappa: 0.03,
+            alpha: 0.05,
+            gamma: 0.0,
+            phit: 0.0,
+            p: f64::NAN,
+            fx: 0.0,
+            fy: 0.0,
+            mx: 0.0,
+            my: 0.0,
+            mz: 0.0,
+        };
+        let mut model = TransientModel::new(TransientConfig {
+            kind: TransientKind::Steady,
+            input_mode: InputMode::Slips,
+            use_mode: UseMode::default(),
+        });
+        let inp = crate::residual::wheel_input(&ext, &sample, None).unwrap();
+        let o = model.step(&ext, &inp, 0.01).unwrap();
+        assert!(
+            (o.friction_scale - 1.1).abs() < 1e-12,
+            "s = {}",
+            o.friction_scale
+        );
+        assert!(
+            (o.stiffness_scale - 1.2).abs() < 1e-12,
+            "c = {}",
+            o.stiffness_scale
+        );
+        // The "measurement" is the extended tyre's own output.
+        let rec = Recording {
+            samples: vec![Sample {
+                fx: o.fx,
+                fy: o.fy,
+                mz: o.mz,
+                ..sample
+            }],
+            ..Default::default()
+        };
+        let seen = through_extension(&rec, &ext, &[o]);
+        let t = &seen.samples[0];
+        let inp = crate::residual::wheel_input(&plain, t, None).unwrap();
+        let q = TransientModel::new(TransientConfig {
+            kind: TransientKind::Steady,
+            input_mode: InputMode::Slips,
+            use_mode: UseMode::default(),
+        })
+        .step(&plain, &inp, 0.01)
+        .unwrap();
+        for (a, b) in [(q.fx, t.fx), (q.fy, t.fy), (q.mz, t.mz)] {
+            assert!((a - b).abs() <= 1e-9 * b.abs().max(1.0), "{a} vs {b}");
+        }
+    }
+}

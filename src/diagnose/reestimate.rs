@@ -40,7 +40,7 @@
 //! (they are the baseline's, fitted without any extension), or return a
 //! file whose in-sample error is higher than the plain refit's.
 
-use super::candidate::{fit_weights, refit_on_all, split, Candidate, Fitted, MAX_LOSS};
+use super::candidate::{every_segment, fit_weights, refit_on_all, Candidate, Fitted, MAX_LOSS};
 use crate::data::Recording;
 use crate::error::Result;
 use crate::fit::mf_stages::StageKind;
@@ -99,9 +99,13 @@ pub struct Reestimated {
     pub fitted: Box<dyn Fitted>,
     /// Rounds kept (0: the plain refit).
     pub rounds: usize,
-    /// In-sample weighted error of the plain refit and of the result.
+    /// In-sample weighted error of the plain refit and of the result (NaN
+    /// when the replay behind them failed).
     pub cost_plain: f64,
     pub cost: f64,
+    /// Why the rounds stopped early on an error (the result is the best
+    /// before it).
+    pub failed: Option<String>,
 }
 
 /// The recording as the plain MF must see it for `tyre`'s extension to
@@ -151,7 +155,8 @@ fn cost(rec: &Recording, sim: &[Forces], all: &[bool], w: &[f64; 3]) -> (f64, [f
 
 /// Alternate the baseline's MF fit and the extension's refit (see the
 /// module docs), starting from `plain`, the extension refitted on
-/// `baseline` ([`refit_on_all`]).
+/// `baseline` ([`refit_on_all`]). Never fails: a step that fails ends the
+/// rounds, keeps the best so far and says why ([`Reestimated::failed`]).
 pub fn reestimate(
     rec: &Recording,
     baseline: &Tyre,
@@ -159,24 +164,38 @@ pub fn reestimate(
     candidate: &dyn Candidate,
     plain: Box<dyn Fitted>,
     refit: &RefitBaseline,
-) -> Result<Reestimated> {
-    let (fit_mask, test_mask) = split(rec);
-    let all: Vec<bool> = fit_mask
-        .iter()
-        .zip(&test_mask)
-        .map(|(a, b)| *a || *b)
-        .collect();
-    let base_sim = replay(rec, baseline, opts)?.sim;
-    let w = fit_weights(rec, &base_sim, &all);
-    let (cost_plain, per_plain) = cost(rec, &plain.predict(rec)?, &all, &w);
+) -> Reestimated {
     let mut best = Reestimated {
         fitted: plain,
         rounds: 0,
-        cost_plain,
-        cost: cost_plain,
+        cost_plain: f64::NAN,
+        cost: f64::NAN,
+        failed: None,
     };
-    if !candidate.reestimable() || !cost_plain.is_finite() {
-        return Ok(best);
+    if candidate.reestimable() {
+        if let Err(e) = rounds(rec, baseline, opts, candidate, refit, &mut best) {
+            best.failed = Some(e.to_string());
+        }
+    }
+    best
+}
+
+/// The rounds of [`reestimate`], improving `best` in place.
+fn rounds(
+    rec: &Recording,
+    baseline: &Tyre,
+    opts: &ReplayOptions,
+    candidate: &dyn Candidate,
+    refit: &RefitBaseline,
+    best: &mut Reestimated,
+) -> Result<()> {
+    let all = every_segment(rec);
+    let w = fit_weights(rec, &replay(rec, baseline, opts)?.sim, &all);
+    let (cost_plain, per_plain) = cost(rec, &best.fitted.predict(rec)?, &all, &w);
+    best.cost_plain = cost_plain;
+    best.cost = cost_plain;
+    if !cost_plain.is_finite() {
+        return Ok(());
     }
     let mut mf = baseline.params().clone();
     for round in 1..=ROUNDS {
@@ -197,17 +216,14 @@ pub fn reestimate(
             break;
         }
         let gain = 1.0 - c / best.cost;
-        best = Reestimated {
-            fitted: next,
-            rounds: round,
-            cost_plain,
-            cost: c,
-        };
+        best.fitted = next;
+        best.rounds = round;
+        best.cost = c;
         if gain < MIN_ROUND_GAIN {
             break;
         }
     }
-    Ok(best)
+    Ok(())
 }
 
 #[cfg(test)]

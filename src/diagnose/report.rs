@@ -728,16 +728,9 @@ pub fn diagnose_with(
                 return Some(plain);
             };
             step("re-estimate baseline");
-            match reestimate(rec, tyre, opts, c.as_ref(), plain, f) {
-                Ok(r) => {
-                    reestimated = Some((r.rounds, r.cost_plain, r.cost));
-                    Some(r.fitted)
-                }
-                Err(e) => {
-                    refit_failed = Some(format!("re-estimating the baseline: {e}"));
-                    refit_on_all(rec, tyre, opts, c.as_ref()).ok()
-                }
-            }
+            let r = reestimate(rec, tyre, opts, c.as_ref(), plain, f);
+            reestimated = Some((r.rounds, r.cost_plain, r.cost, r.failed));
+            Some(r.fitted)
         });
     let verdict = if slip_verdict {
         "rolling_radius".to_string()
@@ -841,7 +834,12 @@ pub fn diagnose_with(
             " extended.tir holds the half fit scored above: its refit on every segment failed ({e})."
         ));
     }
-    let baseline_reestimated = reestimated.map(|(rounds, plain, after)| BaselineReestimated {
+    if let Some((_, _, _, Some(e))) = &reestimated {
+        explanation.push_str(&format!(
+            " Re-estimating the baseline beneath the extension stopped on an error ({e}); extended.tir holds the best before it."
+        ));
+    }
+    let baseline_reestimated = reestimated.map(|(rounds, plain, after, _)| BaselineReestimated {
         rounds,
         error_change: after / plain - 1.0,
     });

@@ -102,8 +102,8 @@ pub use selection::{
     also_qualifying, channels_in_words, qualifies, select, why_not, MAX_LOSS, MIN_GAIN,
 };
 pub use statistics::{
-    evaluate, fit_weights, held_out_sse, refit_on_all, smoothed_inputs, split, ChannelScore,
-    Evaluation, DECORRELATION_TIME, SMOOTH_HALF_WIDTH,
+    evaluate, every_segment, fit_weights, held_out_sse, refit_on_all, smoothed_inputs, split,
+    ChannelScore, Evaluation, DECORRELATION_TIME, SMOOTH_HALF_WIDTH,
 };
 
 use crate::data::Recording;

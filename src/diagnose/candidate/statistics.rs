@@ -372,6 +372,12 @@ fn either(fit: &[bool], test: &[bool]) -> Vec<bool> {
     fit.iter().zip(test).map(|(a, b)| *a || *b).collect()
 }
 
+/// Every segment of `rec` (both halves of [`split`]) as a sample mask.
+pub fn every_segment(rec: &Recording) -> Vec<bool> {
+    let (fit, test) = split(rec);
+    either(&fit, &test)
+}
+
 /// The named candidate refitted on every segment (both halves of
 /// [`split`]) once the selection is made: the held-out scores of
 /// [`evaluate`] choose the model, and its parameters are then estimated on

@@ -59,7 +59,8 @@
 //!   per-sample log-likelihood ratio), so a badly fitted channel cannot
 //!   dominate a well fitted one. BIC over both halves,
 //!   n_eff·ln(SSE ratio) + k·ln(n_eff), n_eff = recorded seconds
-//!   ([`DECORRELATION_TIME`]), k = parameters fitted.
+//!   ([`DECORRELATION_TIME`]), k = parameters fitted (per channel: those
+//!   acting on the channel, [`Fitted::parameters_on`]).
 //! * Verdict ([`select`], [`qualifies`]): a candidate qualifies when some
 //!   channel's held-out error falls by more than [`MIN_GAIN`] and that
 //!   channel's own BIC falls (an effect may live in one channel), none rises
@@ -137,6 +138,12 @@ pub trait Fitted: Send + Sync {
     /// ([`Spec::eliminate`]).
     fn held(&self) -> Vec<String> {
         Vec::new()
+    }
+    /// How many of [`Fitted::parameters`] act on channel `j` (index into
+    /// [`crate::residual::Channel::SCORED`]): what that channel's own BIC
+    /// charges ([`ChannelScore::delta_bic`]). By default all of them.
+    fn parameters_on(&self, _j: usize) -> usize {
+        self.parameters().len()
     }
 }
 

@@ -29,6 +29,8 @@ struct Model {
     opts: ReplayOptions,
     kappa_re: bool,
     params: Vec<(String, f64)>,
+    /// How many of `params` act on each channel ([`Param::on`]).
+    params_on: [usize; 3],
     at_bound: Vec<String>,
     held: Vec<String>,
 }
@@ -98,6 +100,9 @@ impl Fitted for Model {
     fn held(&self) -> Vec<String> {
         self.held.clone()
     }
+    fn parameters_on(&self, j: usize) -> usize {
+        self.params_on.get(j).copied().unwrap_or(self.params.len())
+    }
 }
 
 /// The baseline itself.
@@ -130,6 +135,7 @@ impl Candidate for NoneCandidate {
             opts: *opts,
             kappa_re: false,
             params: vec![],
+            params_on: [0; 3],
             at_bound: vec![],
             held: vec![],
         }))
@@ -669,6 +675,7 @@ impl Candidate for ParamCandidate {
                 opts: o,
                 kappa_re: spec.kappa_re,
                 params: vec![],
+                params_on: [0; 3],
                 at_bound: vec![],
                 held: vec![],
             })
@@ -757,6 +764,8 @@ impl Candidate for ParamCandidate {
             .zip(&theta)
             .map(|(q, v)| (q.name.to_string(), *v))
             .collect();
+        m.params_on =
+            std::array::from_fn(|j| params.iter().filter(|q| q.channels.contains(&j)).count());
         m.at_bound = params
             .iter()
             .zip(&theta)

@@ -29,8 +29,9 @@ pub struct ChannelScore {
     pub fit_gain: f64,
     /// BIC change of this channel alone over both halves (negative =
     /// better): n_k·ln(SSE_k/SSE_k,base) + p·ln(n_k), n_k = the channel's
-    /// recorded seconds ([`DECORRELATION_TIME`]), p = all the candidate's
-    /// fitted parameters. See [`evaluate`].
+    /// recorded seconds ([`DECORRELATION_TIME`]), p = the fitted parameters
+    /// that act on the channel ([`Fitted::parameters_on`]; all of them when
+    /// the candidate declares none for it). See [`evaluate`].
     pub delta_bic: f64,
 }
 
@@ -258,10 +259,14 @@ pub const DECORRELATION_TIME: f64 = 1.0;
 /// the recording's seconds counted once for all channels together (Fy and
 /// Mz residuals of one sweep are not independent evidence), so a channel's
 /// gain enters with its share of the samples. Per channel
-/// ([`ChannelScore::delta_bic`]) the same with the channel's own seconds
-/// and SSE ratio: the evidence of an effect that lives in one channel (a
-/// friction law of the sliding speed in the drive/brake sweeps' Fx), which
-/// the pooled figure dilutes by the channels it does not act on.
+/// ([`ChannelScore::delta_bic`]) the same with the channel's own seconds,
+/// SSE ratio and the parameters acting on it: the evidence of an effect
+/// that lives in one channel (a friction law of the sliding speed in the
+/// drive/brake sweeps' Fx), which the pooled figure dilutes by the channels
+/// it does not act on. A parameter that cannot move a channel's prediction
+/// (PPX1 in Fy) is not part of that channel's model, so it is not charged
+/// there; the pooled BIC, which ranks the qualifying candidates, charges
+/// every parameter.
 pub fn evaluate(
     rec: &Recording,
     baseline: &Tyre,
@@ -326,7 +331,11 @@ pub fn evaluate(
                             fit_gain: gain(sb[0][j].0, s[0][j].0),
                             delta_bic: {
                                 let n = (s[2][j].1 as f64 * h / DECORRELATION_TIME).max(2.0);
-                                n * (s[2][j].0 / sb[2][j].0).max(1e-300).ln() + k as f64 * n.ln()
+                                let kj = match fitted.parameters_on(j) {
+                                    0 => k,
+                                    kj => kj.min(k),
+                                };
+                                n * (s[2][j].0 / sb[2][j].0).max(1e-300).ln() + kj as f64 * n.ln()
                             },
                         })
                         .collect();

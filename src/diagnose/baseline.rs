@@ -186,27 +186,45 @@ pub fn fit_baseline(
     threads: usize,
     progress: Option<&mut ProgressFn>,
 ) -> Result<Baseline> {
-    fit_baseline_from(recs, None, None, threads, progress)
+    fit_baseline_from(recs, None, None, Pressures::Pooled, threads, progress)
+}
+
+/// Which pressure the baseline fit sees per sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pressures {
+    /// Every sample at the recordings' median pressure, the pressure terms
+    /// set to 0 and held: a tyre without pressure dependence (the baseline,
+    /// see the module docs).
+    Pooled,
+    /// Each sample at its recorded pressure, the start's pressure terms and
+    /// nominal values (INFLPRES is the pressure terms' reference) held: the
+    /// MF fitted again beneath a named pressure law
+    /// ([`crate::diagnose::reestimate`]).
+    Recorded,
 }
 
 /// [`fit_baseline`] from `start` instead of the built-in tyre (None: the
 /// built-in one) and, given `stages`, only those; the same held keys,
-/// options and thinning otherwise. The re-estimation
-/// ([`crate::diagnose::reestimate`]) fits the baseline again from the
-/// previous one on samples seen through a named extension.
+/// options and thinning otherwise, the samples' pressures as `pressures`
+/// says. The re-estimation ([`crate::diagnose::reestimate`]) fits the
+/// baseline again from the previous one on samples seen through a named
+/// extension.
 pub fn fit_baseline_from(
     recs: &[Recording],
     from: Option<TyreParams>,
     stages: Option<&[StageKind]>,
+    pressures: Pressures,
     threads: usize,
     progress: Option<&mut ProgressFn>,
 ) -> Result<Baseline> {
     let n: usize = recs.iter().map(|r| r.samples.len()).sum();
     let stride = n.div_ceil(MAX_FIT_SAMPLES).max(1);
+    let pooled = pressures == Pressures::Pooled;
     let p_med = median(
         recs.iter()
             .flat_map(|r| r.samples.iter().step_by(10).map(|s| s.p)),
-    );
+    )
+    .filter(|_| pooled);
     let data: Vec<Recording> = recs
         .iter()
         .map(|r| {
@@ -227,12 +245,15 @@ pub fn fit_baseline_from(
         })
         .collect();
     let mut start = from.unwrap_or_else(TyreParams::builtin);
-    for k in HELD_PRESSURE_KEYS {
-        start.set(k, 0.0)?;
+    if pooled {
+        for k in HELD_PRESSURE_KEYS {
+            start.set(k, 0.0)?;
+        }
     }
     let mut opts = MfFitOptions {
         holdout: Holdout::None,
-        nominal_from_data: true,
+        nominal_from_data: pooled,
+        hold_pressure: !pooled,
         // The tyre's own radii from the recording: `replay` and the FMU
         // derive κ from the wheel speed through the file's Re(Fz), so a
         // baseline with another tyre's geometry would misfit every channel

@@ -31,16 +31,24 @@
 //! selection allows a named effect ([`MAX_LOSS`]), so the file is never
 //! worse than the plain refit on the data it was fitted to.
 //!
-//! Only for candidates that act through slips and similarity scales alone
-//! ([`Candidate::reestimable`]: load sensitivity, speed friction, thermal,
-//! relaxation), and only when the diagnosis fitted its baseline itself: a
-//! baseline given with `--tir` is the user's tyre and stays.
+//! So for candidates that act through slips and similarity scales alone
+//! ([`Reestimation::ThroughScales`]: load sensitivity, speed friction,
+//! thermal, relaxation). A pressure law is made of the MF's own pressure
+//! terms ([`Reestimation::AtRecordedPressure`]): there step 2 is the
+//! recording itself at its recorded pressures, fitted from the extended
+//! tyre with the candidate's pressure terms held (the baseline pooled every
+//! sample at the median pressure, so its curves are a compromise over the
+//! pressures the data swept). Only when the diagnosis fitted its baseline
+//! itself: a baseline given with `--tir` is the user's tyre and stays.
 //!
 //! Must never: change the verdict, the held-out scores or `baseline.tir`
 //! (they are the baseline's, fitted without any extension), or return a
 //! file whose in-sample error is higher than the plain refit's.
 
-use super::candidate::{every_segment, fit_weights, refit_on_all, Candidate, Fitted, MAX_LOSS};
+use super::baseline::Pressures;
+use super::candidate::{
+    every_segment, fit_weights, refit_on_all, Candidate, Fitted, Reestimation, MAX_LOSS,
+};
 use crate::data::Recording;
 use crate::error::Result;
 use crate::fit::mf_stages::StageKind;
@@ -71,20 +79,22 @@ pub const REESTIMATED_STAGES: [StageKind; 3] =
     [StageKind::PureFx, StageKind::PureFy, StageKind::Mz];
 
 /// Fits the baseline again: (the recording as the plain MF must see it,
-/// the previous baseline to start from) → the new baseline.
-pub type RefitBaseline<'a> = dyn Fn(&Recording, &TyreParams) -> Result<TyreParams> + Sync + 'a;
+/// the tyre to start from, the pressures the fit sees) → the new baseline.
+pub type RefitBaseline<'a> =
+    dyn Fn(&Recording, &TyreParams, Pressures) -> Result<TyreParams> + Sync + 'a;
 
 /// The [`RefitBaseline`] of a baseline the diagnosis fitted itself
 /// ([`super::baseline::fit_baseline`]): the same fit from the previous
 /// baseline, [`REESTIMATED_STAGES`] only.
 pub fn refit_fitted_baseline(
     threads: usize,
-) -> impl Fn(&Recording, &TyreParams) -> Result<TyreParams> + Sync {
-    move |r, start| {
+) -> impl Fn(&Recording, &TyreParams, Pressures) -> Result<TyreParams> + Sync {
+    move |r, start, pressures| {
         super::baseline::fit_baseline_from(
             std::slice::from_ref(r),
             Some(start.clone()),
             Some(&REESTIMATED_STAGES),
+            pressures,
             threads,
             None,
         )
@@ -199,11 +209,19 @@ fn rounds(
     }
     let mut mf = baseline.params().clone();
     for round in 1..=ROUNDS {
-        let Some(out) = best.fitted.outputs(rec)? else {
-            break;
+        mf = match candidate.reestimation() {
+            Reestimation::No => break,
+            Reestimation::ThroughScales => {
+                let Some(out) = best.fitted.outputs(rec)? else {
+                    break;
+                };
+                let seen = through_extension(rec, best.fitted.tyre(), &out);
+                refit(&seen, &mf, Pressures::Pooled)?
+            }
+            Reestimation::AtRecordedPressure => {
+                refit(rec, best.fitted.tyre().params(), Pressures::Recorded)?
+            }
         };
-        let seen = through_extension(rec, best.fitted.tyre(), &out);
-        mf = refit(&seen, &mf)?;
         let next = refit_on_all(rec, &Tyre::new(mf.clone())?, opts, candidate)?;
         let (c, per) = cost(rec, &next.predict(rec)?, &all, &w);
         // Kept when the error falls and no channel's rises beyond what the

@@ -54,6 +54,12 @@ pub struct MfFitOptions {
     pub fit: FitOptions,
     /// Minimum samples for a stage to run.
     pub min_samples: usize,
+    /// Hold the pressure terms (PPX*, PPY*, PPZ*, PPMX1) at the start's
+    /// values whatever pressures the data hold. Off: they are fitted when
+    /// the data span more than [`PRESSURE_SPREAD`]. The diagnosis fits its
+    /// baseline beneath a named pressure law with them held
+    /// ([`crate::diagnose::reestimate`]).
+    pub hold_pressure: bool,
 }
 
 impl Default for MfFitOptions {
@@ -78,6 +84,7 @@ impl Default for MfFitOptions {
                 ..Default::default()
             },
             min_samples: 50,
+            hold_pressure: false,
         }
     }
 }
@@ -452,7 +459,7 @@ pub(crate) fn run_stage(
         kind,
         &tyre.p,
         data.gamma_spread < CAMBER_SPREAD,
-        data.p_spread < PRESSURE_SPREAD,
+        data.p_spread < PRESSURE_SPREAD || opts.hold_pressure,
     );
     if kind == StageKind::Combined {
         for p in params.iter_mut() {

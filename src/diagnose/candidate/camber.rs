@@ -4,6 +4,7 @@
 //! a value the fit did not produce.
 
 use super::param::{file, is_mf6, key, p, ParamCandidate, Spec};
+use super::Reestimation;
 use super::{FY, MZ};
 use crate::mf::Tyre;
 use crate::residual::ReplayOptions;
@@ -55,6 +56,6 @@ pub(super) fn candidate() -> ParamCandidate {
                 .collect::<Vec<_>>()
                 .join(", ")
         },
-        reestimable: false,
+        reestimation: Reestimation::No,
     }
 }

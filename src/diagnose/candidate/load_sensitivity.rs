@@ -24,6 +24,7 @@
 
 use super::param::{p, ParamCandidate, Spec, Target};
 use super::Fitted;
+use super::Reestimation;
 use crate::data::Recording;
 use crate::mf::Tyre;
 use crate::residual::ReplayOptions;
@@ -156,6 +157,6 @@ pub(super) fn candidate() -> ParamCandidate {
         n: 2 * KNOTS,
         spec: load_spec,
         words,
-        reestimable: true,
+        reestimation: Reestimation::ThroughScales,
     }
 }

@@ -4,6 +4,7 @@
 //! a value the fit did not produce.
 
 use super::param::{nominal_props, p, param, ParamCandidate, Spec, Target};
+use super::Reestimation;
 use super::{FX, FY, MZ};
 use crate::mf::Tyre;
 use crate::residual::ReplayOptions;
@@ -67,6 +68,6 @@ pub(super) fn candidate() -> ParamCandidate {
                 param(f, "MUS")
             )
         },
-        reestimable: false,
+        reestimation: Reestimation::No,
     }
 }

@@ -77,8 +77,9 @@
 //!   fitted again on both halves for `extended.tir` (the half fit chose
 //!   it; all segments estimate it). The scores stay the half fit's. When
 //!   the diagnosis fitted the baseline itself, a candidate that acts
-//!   through slips and similarity scales ([`Candidate::reestimable`]) then
-//!   has the baseline fitted again beneath it ([`crate::diagnose::reestimate`]).
+//!   through slips and similarity scales, or through the MF's pressure
+//!   terms ([`Candidate::reestimation`]), then has the baseline fitted
+//!   again beneath it ([`crate::diagnose::reestimate`]).
 //!
 //! Must never: let a candidate see the held-out segments' forces while
 //! fitting (their inputs may drive a state), or panic on a recording with
@@ -147,6 +148,24 @@ pub trait Fitted: Send + Sync {
     }
 }
 
+/// How the baseline's MF can be fitted again beneath a named extension
+/// ([`crate::diagnose::reestimate`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Reestimation {
+    /// It cannot: the extension changes what no MF stage fits (the source
+    /// of the slip for the rolling radius, LuGre's bristles) or shares keys
+    /// with it (camber).
+    No,
+    /// On the recording seen through the step's slips and similarity
+    /// scales: an extension that acts through them alone (load
+    /// sensitivity, speed friction, thermal, relaxation).
+    ThroughScales,
+    /// On the recording at its recorded pressures with the candidate's
+    /// pressure terms held: an extension made of the MF's own pressure
+    /// terms.
+    AtRecordedPressure,
+}
+
 /// A candidate extension.
 pub trait Candidate: Send + Sync {
     fn name(&self) -> &'static str;
@@ -156,11 +175,14 @@ pub trait Candidate: Send + Sync {
     fn physics(&self) -> &'static str {
         self.name()
     }
-    /// Whether the extension acts only through the step's slips and
-    /// similarity scales, so that the baseline can be fitted again beneath
-    /// it ([`crate::diagnose::reestimate`]).
+    /// How the baseline can be fitted again beneath the extension
+    /// ([`crate::diagnose::reestimate`]).
+    fn reestimation(&self) -> Reestimation {
+        Reestimation::No
+    }
+    /// Whether the baseline can be fitted again beneath the extension at all.
     fn reestimable(&self) -> bool {
-        false
+        self.reestimation() != Reestimation::No
     }
     /// The fitted extension in words with its key parameter(s), e.g.
     /// "a relaxation length of 0.31 m (×1.2 the file's)".

@@ -9,7 +9,7 @@
 //! parameter whose channels carry no data, or report a value at a bound
 //! without saying so ([`Fitted::at_bound`]).
 
-use super::{Candidate, Fitted, ALL_CHANNELS};
+use super::{Candidate, Fitted, Reestimation, ALL_CHANNELS};
 use crate::data::Recording;
 use crate::error::Result;
 use crate::mf::{Forces, MfInput, Tyre};
@@ -573,8 +573,8 @@ pub struct ParamCandidate {
     pub n: usize,
     pub spec: fn(&Tyre, &ReplayOptions) -> Option<Spec>,
     pub words: fn(&dyn Fitted) -> String,
-    /// See [`Candidate::reestimable`].
-    pub reestimable: bool,
+    /// See [`Candidate::reestimation`].
+    pub reestimation: Reestimation,
 }
 
 /// Fit-half sample indices, thinned to at most `max` (evenly).
@@ -594,8 +594,8 @@ impl Candidate for ParamCandidate {
     fn physics(&self) -> &'static str {
         self.physics
     }
-    fn reestimable(&self) -> bool {
-        self.reestimable
+    fn reestimation(&self) -> Reestimation {
+        self.reestimation
     }
     fn describe(&self, f: &dyn Fitted) -> String {
         let held = f.held();

@@ -21,6 +21,7 @@
 //! a value the fit did not produce.
 
 use super::param::{file, is_mf6, key, p, param, ParamCandidate, Spec};
+use super::Reestimation;
 use super::{FX, FY, MZ};
 use crate::mf::Tyre;
 use crate::residual::ReplayOptions;
@@ -84,6 +85,6 @@ pub(super) fn candidate() -> ParamCandidate {
         n: TERMS.len(),
         spec: pressure_spec,
         words,
-        reestimable: false,
+        reestimation: Reestimation::AtRecordedPressure,
     }
 }

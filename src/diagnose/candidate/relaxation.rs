@@ -4,6 +4,7 @@
 //! a value the fit did not produce.
 
 use super::param::{file, key, nominal_props, p, ParamCandidate, Spec};
+use super::Reestimation;
 use super::{FX, FY, MZ};
 use crate::mf::Tyre;
 use crate::residual::ReplayOptions;
@@ -51,6 +52,6 @@ pub(super) fn candidate() -> ParamCandidate {
                 o.sigmay, o.sigmax
             )
         },
-        reestimable: true,
+        reestimation: Reestimation::ThroughScales,
     }
 }

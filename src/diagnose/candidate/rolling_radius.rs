@@ -13,6 +13,7 @@
 //! a value the fit did not produce.
 
 use super::param::{file, key, p, param, ParamCandidate, Spec};
+use super::Reestimation;
 use super::FX;
 use crate::mf::Tyre;
 use crate::residual::ReplayOptions;
@@ -45,6 +46,6 @@ pub(super) fn candidate() -> ParamCandidate {
                 param(f, "FREFF")
             )
         },
-        reestimable: false,
+        reestimation: Reestimation::No,
     }
 }

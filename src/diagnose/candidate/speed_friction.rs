@@ -30,6 +30,7 @@
 //! a value the fit did not produce.
 
 use super::param::{p, param, ParamCandidate, Spec, Target};
+use super::Reestimation;
 use crate::mf::Tyre;
 use crate::residual::ReplayOptions;
 use crate::transient::extension::{SpeedLaw, SPEED_KEYS, SPEED_SECTION};
@@ -130,6 +131,6 @@ pub(super) fn candidate() -> ParamCandidate {
                 l.vref
             )
         },
-        reestimable: true,
+        reestimation: Reestimation::ThroughScales,
     }
 }

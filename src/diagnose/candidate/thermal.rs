@@ -18,6 +18,7 @@
 //! a value the fit did not produce.
 
 use super::param::{p, param, ParamCandidate, Spec, Target};
+use super::Reestimation;
 use crate::mf::Tyre;
 use crate::residual::ReplayOptions;
 use crate::transient::extension::THERMAL_SECTION;
@@ -90,7 +91,7 @@ pub(super) fn candidate() -> ParamCandidate {
                 m(1.0)
             )
         },
-        reestimable: true,
+        reestimation: Reestimation::ThroughScales,
     }
 }
 

@@ -141,29 +141,33 @@ fn replay(exe: &str, rec: &Path, tir: &Path, out: &Path) {
     );
 }
 
-fn run(a: &Answer, dir: &Path, data: &Path) -> Outcome {
-    let exe = env!("CARGO_BIN_EXE_tyrekit");
-    let report = dir.join(&a.name);
-    let t0 = std::time::Instant::now();
-    let o = Command::new(exe)
+/// `tyrekit diagnose REC --report DIR` as a user runs it; the verdict.
+fn diagnose_cli(name: &str, rec: &Path, report: &Path) -> String {
+    let o = Command::new(env!("CARGO_BIN_EXE_tyrekit"))
         .arg("diagnose")
-        .arg(&a.file)
+        .arg(rec)
         .arg("--report")
-        .arg(&report)
+        .arg(report)
         .output()
         .expect("run tyrekit diagnose");
     assert!(
         o.status.success(),
-        "{}: tyrekit diagnose failed: {}",
-        a.name,
+        "{name}: tyrekit diagnose failed: {}",
         String::from_utf8_lossy(&o.stderr)
     );
-    let seconds = t0.elapsed().as_secs_f64();
     let j: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(report.join("diagnosis.json")).expect("diagnosis.json"),
     )
     .expect("diagnosis.json is JSON");
-    let verdict = j["verdict"].as_str().expect("verdict").to_string();
+    j["verdict"].as_str().expect("verdict").to_string()
+}
+
+fn run(a: &Answer, dir: &Path, data: &Path) -> Outcome {
+    let exe = env!("CARGO_BIN_EXE_tyrekit");
+    let report = dir.join(&a.name);
+    let t0 = std::time::Instant::now();
+    let verdict = diagnose_cli(&a.name, &a.file, &report);
+    let seconds = t0.elapsed().as_secs_f64();
     let (effect, pure) = answer_of(data, &a.name);
     let (channel, ab, at) = gap_channel(&pure);
     let raw = devset::read_raw(&a.file);
@@ -377,25 +381,7 @@ fn devset_verdicts_hold_at_half_the_sample_rate() {
             }
         }
         drop(out);
-        let report = work.join(&a.name);
-        let o = Command::new(env!("CARGO_BIN_EXE_tyrekit"))
-            .arg("diagnose")
-            .arg(&thin)
-            .arg("--report")
-            .arg(&report)
-            .output()
-            .expect("run tyrekit diagnose");
-        assert!(
-            o.status.success(),
-            "{}: tyrekit diagnose failed: {}",
-            a.name,
-            String::from_utf8_lossy(&o.stderr)
-        );
-        let j: serde_json::Value = serde_json::from_str(
-            &std::fs::read_to_string(report.join("diagnosis.json")).expect("diagnosis.json"),
-        )
-        .expect("diagnosis.json is JSON");
-        let verdict = j["verdict"].as_str().expect("verdict").to_string();
+        let verdict = diagnose_cli(&a.name, &thin, &work.join(&a.name));
         (a.name.clone(), answer_of(data, &a.name).0, verdict)
     }) else {
         return;

@@ -204,8 +204,9 @@ pub enum Pressures {
 }
 
 /// [`fit_baseline`] from `start` instead of the built-in tyre (None: the
-/// built-in one) and, given `stages`, only those; the same held keys,
-/// options and thinning otherwise, the samples' pressures as `pressures`
+/// built-in one; given, its radii and vertical keys are kept — the
+/// geometry step runs only from the built-in tyre) and, given `stages`,
+/// only those; the same held keys, options and thinning otherwise, the samples' pressures as `pressures`
 /// says. The re-estimation ([`crate::diagnose::reestimate`]) fits the
 /// baseline again from the previous one on samples seen through a named
 /// extension.
@@ -244,6 +245,7 @@ pub fn fit_baseline_from(
             d
         })
         .collect();
+    let geometry = from.is_none();
     let mut start = from.unwrap_or_else(TyreParams::builtin);
     if pooled {
         for k in HELD_PRESSURE_KEYS {
@@ -258,7 +260,9 @@ pub fn fit_baseline_from(
         // derive κ from the wheel speed through the file's Re(Fz), so a
         // baseline with another tyre's geometry would misfit every channel
         // (dev set r01: Fy NRMSE 0.099 against 0.008 with the recording's Re).
-        geometry: true,
+        // From a previous baseline they are the data's already, and a
+        // rolling-radius finding's own Re(Fz) must stay.
+        geometry,
         threads: threads.max(1),
         ..Default::default()
     };

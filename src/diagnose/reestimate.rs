@@ -46,6 +46,7 @@
 //! file whose in-sample error is higher than the plain refit's.
 
 use super::baseline::Pressures;
+use super::candidate::param::rerolled;
 use super::candidate::{
     every_segment, fit_weights, refit_on_all, Candidate, Fitted, Reestimation, MAX_LOSS,
 };
@@ -242,6 +243,72 @@ fn rounds(
         }
     }
     Ok(())
+}
+
+/// What [`beneath_rolling_radius`] returns: the tyre for `extended.tir`
+/// and the same account as [`Reestimated`].
+pub struct RadiusReestimated {
+    pub tyre: Tyre,
+    pub rounds: usize,
+    pub cost_plain: f64,
+    pub cost: f64,
+    pub failed: Option<String>,
+}
+
+/// The MF fitted again beneath a rolling-radius finding `ext` (the
+/// baseline with the tyre's own Re(Fz) and Fx's horizontal shift
+/// re-centred, [`super::slip_channel`]). The baseline's stages were fitted
+/// on the recording's slip, computed through another radius; the finding
+/// changes the slip every sample sees (κ′ = (1 + κ)·Re_ext/Re_base − 1,
+/// [`rerolled`]), and the pure and Mz stages are fitted again on the
+/// recording with that κ′ from `ext`, whose radius keys the fit keeps
+/// ([`super::baseline::fit_baseline_from`] from a given start runs no
+/// geometry step). One round: there is no
+/// extension parameter to alternate with. Kept under the guards of
+/// [`reestimate`] (in-sample error on the recording as the finding sees it
+/// falls, no channel's rises by more than [`MAX_LOSS`]); otherwise `ext`.
+/// Never fails.
+pub fn beneath_rolling_radius(
+    rec: &Recording,
+    baseline: &Tyre,
+    ext: &Tyre,
+    opts: &ReplayOptions,
+    refit: &RefitBaseline,
+) -> RadiusReestimated {
+    let mut out = RadiusReestimated {
+        tyre: ext.clone(),
+        rounds: 0,
+        cost_plain: f64::NAN,
+        cost: f64::NAN,
+        failed: None,
+    };
+    let mut once = || -> Result<()> {
+        let seen = rerolled(rec, baseline, ext, opts);
+        let all = every_segment(rec);
+        let w = fit_weights(rec, &replay(rec, baseline, opts)?.sim, &all);
+        let (c0, per0) = cost(&seen, &replay(&seen, ext, opts)?.sim, &all, &w);
+        out.cost_plain = c0;
+        out.cost = c0;
+        if !c0.is_finite() {
+            return Ok(());
+        }
+        let t = Tyre::new(refit(&seen, ext.params(), Pressures::Pooled)?)?;
+        let (c, per) = cost(&seen, &replay(&seen, &t, opts)?.sim, &all, &w);
+        let worse = per
+            .iter()
+            .zip(&per0)
+            .any(|(a, b)| a.is_nan() || *a > (1.0 + MAX_LOSS) * b);
+        if c.is_finite() && c < c0 && !worse {
+            out.tyre = t;
+            out.rounds = 1;
+            out.cost = c;
+        }
+        Ok(())
+    };
+    if let Err(e) = once() {
+        out.failed = Some(e.to_string());
+    }
+    out
 }
 
 #[cfg(test)]

@@ -33,7 +33,7 @@ use super::candidate::{
     ChannelScore, Evaluation,
 };
 use super::locate::{frictional_energy, locate, Finding, LocateOptions, Residuals};
-use super::reestimate::{reestimate, RefitBaseline};
+use super::reestimate::{beneath_rolling_radius, reestimate, RefitBaseline};
 use super::slip_channel;
 use crate::data::Recording;
 use crate::error::Result;
@@ -732,6 +732,17 @@ pub fn diagnose_with(
             reestimated = Some((r.rounds, r.cost_plain, r.cost, r.failed));
             Some(r.fitted)
         });
+    // A rolling-radius finding: the MF fitted again beneath the tyre's own
+    // Re(Fz) ([`crate::diagnose::reestimate::beneath_rolling_radius`]).
+    let slip_file = match (&slip_ext, slip_verdict, refit_baseline) {
+        (Some(t), true, Some(f)) => {
+            step("re-estimate baseline");
+            let r = beneath_rolling_radius(rec, tyre, t, opts, f);
+            reestimated = Some((r.rounds, r.cost_plain, r.cost, r.failed));
+            Some(r.tyre)
+        }
+        _ => None,
+    };
     let verdict = if slip_verdict {
         "rolling_radius".to_string()
     } else {
@@ -889,13 +900,15 @@ pub fn diagnose_with(
         .map(|(ch, f)| (ch.key(), f.clone()))
         .collect();
     let extended = match (&slip_ext, slip_verdict, &refit) {
-        (Some(t), true, _) => t.clone(),
+        (Some(t), true, _) => slip_file.unwrap_or_else(|| t.clone()),
         (_, _, Some(r)) => r.tyre().clone(),
         _ => verdict_i.map_or_else(|| tyre.clone(), |i| ev[i].1.tyre().clone()),
     };
     // The series the plots draw are what extended.tir does.
     if let Some(r) = &refit {
         extended_sim = r.predict(rec)?;
+    } else if slip_verdict && baseline_reestimated.as_ref().is_some_and(|r| r.rounds > 0) {
+        extended_sim = replay(&rerolled(rec, tyre, &extended, opts), &extended, opts)?.sim;
     }
     let extended_parameters = refit
         .as_ref()

@@ -206,10 +206,10 @@ pub enum Pressures {
 /// [`fit_baseline`] from `start` instead of the built-in tyre (None: the
 /// built-in one; given, its radii and vertical keys are kept — the
 /// geometry step runs only from the built-in tyre) and, given `stages`,
-/// only those; the same held keys, options and thinning otherwise, the samples' pressures as `pressures`
-/// says. The re-estimation ([`crate::diagnose::reestimate`]) fits the
-/// baseline again from the previous one on samples seen through a named
-/// extension.
+/// only those; the samples' pressures as `pressures` says; the same held
+/// keys, options and thinning otherwise. The re-estimation
+/// ([`crate::diagnose::reestimate`]) fits the baseline again from the
+/// extended tyre or the previous baseline.
 pub fn fit_baseline_from(
     recs: &[Recording],
     from: Option<TyreParams>,

@@ -140,13 +140,22 @@ fn recording(tyre: &Tyre, law: Law) -> Recording {
         s.fy += 12.0 * g();
         s.mz += 0.4 * g();
     }
-    let (sweep_dir, t_in_segment) = sweep_and_time(&samples, &run.plan);
+    as_recording(format!("{law:?}"), samples, run.plan)
+}
+
+/// Samples and the programme's segments as a recording.
+fn as_recording(
+    source: String,
+    samples: Vec<tyrekit::data::Sample>,
+    segments: Vec<tyrekit::data::Segment>,
+) -> Recording {
+    let (sweep_dir, t_in_segment) = sweep_and_time(&samples, &segments);
     Recording {
-        source: format!("{law:?}"),
+        source,
         samples,
         channels: SAMPLE_CHANNELS.iter().map(|c| c.to_string()).collect(),
         extra: vec![],
-        segments: run.plan,
+        segments,
         sweep_dir,
         t_in_segment,
     }
@@ -320,16 +329,7 @@ fn heating_with_gas_law_pressure(level: f64) -> tyrekit::diagnose::report::Diagn
         s.fy += 12.0 * g();
         s.mz += 0.4 * g();
     }
-    let (sweep_dir, t_in_segment) = sweep_and_time(&samples, &run.plan);
-    let rec = Recording {
-        source: "thermal, pressure by the gas law".into(),
-        samples,
-        channels: SAMPLE_CHANNELS.iter().map(|c| c.to_string()).collect(),
-        extra: vec![],
-        segments: run.plan,
-        sweep_dir,
-        t_in_segment,
-    };
+    let rec = as_recording("thermal, pressure by the gas law".into(), samples, run.plan);
     let d = diagnose(&rec, &tyre, &opts()).unwrap();
     show(&d);
     d

@@ -38,8 +38,11 @@
 //! recording itself at its recorded pressures, fitted from the extended
 //! tyre with the candidate's pressure terms held (the baseline pooled every
 //! sample at the median pressure, so its curves are a compromise over the
-//! pressures the data swept). Only when the diagnosis fitted its baseline
-//! itself: a baseline given with `--tir` is the user's tyre and stays.
+//! pressures the data swept). A rolling-radius finding of the slip channel
+//! changes the slip every sample sees ([`beneath_rolling_radius`]): the
+//! stages are fitted once more on the recording with that slip. Only when
+//! the diagnosis fitted its baseline itself: a baseline given with `--tir`
+//! is the user's tyre and stays.
 //!
 //! Must never: change the verdict, the held-out scores or `baseline.tir`
 //! (they are the baseline's, fitted without any extension), or return a

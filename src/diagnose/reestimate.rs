@@ -167,6 +167,18 @@ fn cost(rec: &Recording, sim: &[Forces], all: &[bool], w: &[f64; 3]) -> (f64, [f
     (weighted_sse(rec, sim, all, w, &o), per)
 }
 
+/// Whether a re-estimated file with in-sample error `(c, per channel)` is
+/// kept against the best so far (`best`) and the plain refit's channels
+/// (`plain`): the error falls and no channel's rises beyond what the
+/// selection allows a named effect ([`MAX_LOSS`]).
+fn kept((c, per): (f64, &[f64; 3]), best: f64, plain: &[f64; 3]) -> bool {
+    let worse = per
+        .iter()
+        .zip(plain)
+        .any(|(a, b)| a.is_nan() || *a > (1.0 + MAX_LOSS) * b);
+    c.is_finite() && c < best && !worse
+}
+
 /// Alternate the baseline's MF fit and the extension's refit (see the
 /// module docs), starting from `plain`, the extension refitted on
 /// `baseline` ([`refit_on_all`]). Never fails: a step that fails ends the
@@ -228,13 +240,7 @@ fn rounds(
         };
         let next = refit_on_all(rec, &Tyre::new(mf.clone())?, opts, candidate)?;
         let (c, per) = cost(rec, &next.predict(rec)?, &all, &w);
-        // Kept when the error falls and no channel's rises beyond what the
-        // selection allows a named effect ([`MAX_LOSS`]).
-        let worse = per
-            .iter()
-            .zip(&per_plain)
-            .any(|(a, b)| a.is_nan() || *a > (1.0 + MAX_LOSS) * b);
-        if c.is_nan() || c >= best.cost || worse {
+        if !kept((c, &per), best.cost, &per_plain) {
             break;
         }
         let gain = 1.0 - c / best.cost;
@@ -297,11 +303,7 @@ pub fn beneath_rolling_radius(
         }
         let t = Tyre::new(refit(&seen, ext.params(), Pressures::Pooled)?)?;
         let (c, per) = cost(&seen, &replay(&seen, &t, opts)?.sim, &all, &w);
-        let worse = per
-            .iter()
-            .zip(&per0)
-            .any(|(a, b)| a.is_nan() || *a > (1.0 + MAX_LOSS) * b);
-        if c.is_finite() && c < c0 && !worse {
+        if kept((c, &per), c0, &per0) {
             out.tyre = t;
             out.rounds = 1;
             out.cost = c;

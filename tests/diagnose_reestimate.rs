@@ -17,7 +17,7 @@ mod common;
 
 use tyrekit::data::{Recording, Sample, SegmentKind};
 use tyrekit::diagnose::baseline::{drop_unfitted, fit_baseline};
-use tyrekit::diagnose::reestimate::{refit_fitted_baseline, RefitBaseline};
+use tyrekit::diagnose::reestimate::{refit_fitted_baseline, Refit};
 use tyrekit::diagnose::replay::{replay, ReplayOptions};
 use tyrekit::diagnose::report::{diagnose_with, Diagnosis};
 use tyrekit::mf::Tyre;
@@ -63,6 +63,7 @@ fn lateral_error(
 fn fitted_and_diagnosed(rec: Recording) -> (Recording, Tyre, Diagnosis, Diagnosis) {
     let mut recs = vec![rec];
     let b = fit_baseline(&recs, 2, None).unwrap();
+    let fitted_on = recs[0].clone();
     drop_unfitted(&mut recs, &b);
     let rec = recs.pop().unwrap();
     let base = Tyre::new(b.tyre).unwrap();
@@ -73,7 +74,10 @@ fn fitted_and_diagnosed(rec: Recording) -> (Recording, Tyre, Diagnosis, Diagnosi
         &rec,
         &base,
         &opts,
-        Some(&refit as &RefitBaseline),
+        Some(Refit {
+            fit: &refit,
+            fitted_on: &fitted_on,
+        }),
         &mut |_| {},
     )
     .unwrap();

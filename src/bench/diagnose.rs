@@ -15,7 +15,7 @@
 
 use crate::diagnose::baseline::{drop_unfitted, fit_baseline};
 use crate::diagnose::locate::frictional_energy;
-use crate::diagnose::reestimate::{refit_fitted_baseline, RefitBaseline};
+use crate::diagnose::reestimate::{refit_fitted_baseline, Refit};
 use crate::diagnose::report::{diagnose_with, locate_channel};
 use crate::diagnose::{html, plots};
 use crate::mf::Tyre;
@@ -79,6 +79,7 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let t0 = Instant::now();
     let b = fit_baseline(&recs, threads, None)?;
+    let fitted_on = recs[0].clone();
     drop_unfitted(&mut recs, &b);
     let t_fit = t0.elapsed().as_secs_f64();
     println!(
@@ -93,7 +94,10 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
         rec,
         &fitted,
         &ReplayOptions::default(),
-        Some(&refit as &RefitBaseline),
+        Some(Refit {
+            fit: &refit,
+            fitted_on: &fitted_on,
+        }),
         &mut |_| {},
     )?;
     let t_diag = t0.elapsed().as_secs_f64();

@@ -11,7 +11,7 @@
 
 use crate::data::ReChoice;
 use crate::diagnose::baseline::{drop_unfitted, fit_baseline, HELD_PRESSURE_KEYS};
-use crate::diagnose::reestimate::{refit_fitted_baseline, RefitBaseline};
+use crate::diagnose::reestimate::{refit_fitted_baseline, Refit};
 use crate::diagnose::report::{diagnose_with, merge};
 use crate::diagnose::{html, plots};
 use crate::fit::Progress;
@@ -88,6 +88,8 @@ pub fn run(a: Args) -> Result<()> {
     inputs.extend(a.tir.iter().cloned());
     let mut prov = crate::tir::provenance::Provenance::of_inputs(&inputs)?;
     std::fs::create_dir_all(&a.report).map_err(|e| Error::io(&a.report, e))?;
+    // The recording as the baseline was fitted on, before drop_unfitted.
+    let mut fitted_on = None;
     let (tyre, note) = match (&a.tir, given) {
         (Some(tir), Some(t)) => (
             t,
@@ -122,6 +124,7 @@ pub fn run(a: Args) -> Result<()> {
                 crate::fit::mf_fit::overall_sigma(&fit.report.metrics, ch)
                     .map_or("–".into(), |v| format!("{:.1} %", 100.0 * v))
             };
+            fitted_on = Some(merge(recs.clone()));
             let dropped = drop_unfitted(&mut recs, &fit);
             let mut note = format!(
                 "Baseline: steady MF 6.1 fitted to the recordings (every {}. sample; σ Fx {}, Fy {}, Mz {}), started from the built-in tyre with FNOMIN/NOMPRES/LONGVL from the data; each channel diagnosed on the segment kinds it was fitted on (Mz on cornering only); held (so the candidates can name them): relaxation lengths, pressure terms {} (0, data pooled at the median pressure), LMUV and all scaling factors, BREFF/DREFF/FREFF.",
@@ -164,7 +167,13 @@ pub fn run(a: Args) -> Result<()> {
         &rec,
         &tyre,
         &ReplayOptions::default(),
-        (a.tir.is_none() && !a.keep_baseline).then_some(&refit as &RefitBaseline),
+        fitted_on
+            .as_ref()
+            .filter(|_| !a.keep_baseline)
+            .map(|r| Refit {
+                fit: &refit,
+                fitted_on: r,
+            }),
         &mut step,
     )?;
     let mut base = tyre.params().clone();

@@ -33,7 +33,7 @@ use super::candidate::{
     ChannelScore, Evaluation,
 };
 use super::locate::{frictional_energy, locate, Finding, LocateOptions, Residuals};
-use super::reestimate::{beneath_rolling_radius, reestimate, RefitBaseline};
+use super::reestimate::{beneath_rolling_radius, reestimate, Refit};
 use super::slip_channel;
 use crate::data::Recording;
 use crate::error::Result;
@@ -649,7 +649,7 @@ pub fn diagnose_with(
     rec: &Recording,
     tyre: &Tyre,
     opts: &ReplayOptions,
-    refit_baseline: Option<&RefitBaseline>,
+    refit_baseline: Option<Refit>,
     step: &mut dyn FnMut(&str),
 ) -> Result<Diagnosis> {
     step("replay baseline");

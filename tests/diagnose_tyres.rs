@@ -1,0 +1,108 @@
+//! The diagnosis's own baseline on tyres other than the dev set's: rig
+//! control recordings (no concealed effect; sensor noise, offsets and
+//! scatter only) from real files of `../shared/data/tir/` — MFeval's FSAE
+//! default tyre, a PAC2002 car tyre, a 22.5" truck tyre at 21.7 kN and an
+//! MF 5.2 car tyre —, each diagnosed as a user runs it
+//! (`tyrekit diagnose REC.mat --report DIR`, no `--tir`).
+//!
+//! Asserted per tyre: verdict `none`, and the baseline fitted from the
+//! built-in tyre stands within [`MISFIT_RATIO`] of the noise floor on every
+//! channel (`baseline_fit` of `diagnosis.json`): a control the baseline
+//! cannot fit would be reported as "baseline misfit", and every effect
+//! hidden in a recording of that tyre would go unnamed. The first probe
+//! (28 Nov 2026) found the FSAE tyre's Fx at 3.98× — its PKX2 = −80 lay
+//! outside the fit's box (±50). This test's recording of it, box ±50: Fx
+//! 2.87×, Fy 2.31×, Mz 3.11× (fails); box ±200: 1.92×, 1.42×, 1.72×.
+//!
+//! What this does not show: the rig is the project's own, so it proves the
+//! fit's reach over real parameter sets, not the diagnosis's generality
+//! (that is `diagnose_devset`'s job). Skips with a message without
+//! `../shared`.
+
+mod common;
+
+use std::path::Path;
+use std::process::Command;
+use tyrekit::diagnose::report::MISFIT_RATIO;
+use tyrekit::mf::Tyre;
+use tyrekit::rig::{effects, simulate, RigConfig};
+
+/// The tyres: (file, why it is here).
+const TYRES: [(&str, &str); 4] = [
+    ("FSAE_Defaults.tir", "MFeval's FSAE default; PKX2 = -80"),
+    ("Sedan_Pac02Tire.tir", "PAC2002 car tyre; PEY4 = -760"),
+    (
+        "335_65R22_5_G275MSA_60psi.tir",
+        "truck tyre, FNOMIN 21.7 kN, PDY1 < 0",
+    ),
+    ("MagicFormula52_Parameters.tir", "MF 5.2 car tyre"),
+];
+
+/// A control recording of `tyre`: the rig's standard programme at one
+/// pressure, inclinations 0 and 2°, drive/brake at two slip angles.
+fn control(tyre: &Tyre, seed: u64, path: &Path) {
+    let mut c = RigConfig::standard(tyre, seed);
+    let pr = &mut c.programme;
+    pr.pressures = vec![pr.pressures[1]];
+    pr.inclinations = vec![0.0, 2f64.to_radians()];
+    pr.db_alphas.truncate(2);
+    let mut truth = effects::concealed("none", tyre.clone(), 1.0).expect("control");
+    simulate(&c, truth.as_mut())
+        .write_mat(path, true)
+        .expect("write .mat");
+}
+
+#[test]
+fn the_baseline_fits_controls_of_other_real_tyres_within_the_noise() {
+    let tir = common::shared().join("data/tir");
+    if !tir.exists() {
+        eprintln!("SKIP the_baseline_fits_controls_of_other_real_tyres_within_the_noise: ../shared/data/tir is absent");
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("tyrekit-diag-tyres-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut bad = Vec::new();
+    for (k, (file, why)) in TYRES.iter().enumerate() {
+        let tyre = Tyre::from_file(&tir.join(file)).expect("a shared tyre file");
+        let rec = dir.join(format!("control{k}.mat"));
+        control(&tyre, 100 + k as u64, &rec);
+        let report = dir.join(format!("control{k}"));
+        let o = Command::new(env!("CARGO_BIN_EXE_tyrekit"))
+            .args(["diagnose", rec.to_str().unwrap(), "--report"])
+            .arg(&report)
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{file}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let d: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(report.join("diagnosis.json")).unwrap())
+                .unwrap();
+        let fits: Vec<(String, f64)> = d["baseline_fit"]
+            .as_array()
+            .expect("baseline_fit")
+            .iter()
+            .map(|f| {
+                (
+                    f["channel"].as_str().unwrap_or("?").to_string(),
+                    f["ratio"].as_f64().unwrap_or(f64::NAN),
+                )
+            })
+            .collect();
+        println!(
+            "{file} ({why}): verdict {}, baseline/noise {fits:?}",
+            d["verdict"]
+        );
+        assert_eq!(fits.len(), 3, "{file}: Fx, Fy and Mz scored");
+        if d["verdict"] != "none" || fits.iter().any(|(_, r)| !(*r < MISFIT_RATIO)) {
+            bad.push(format!("{file}: verdict {}, {fits:?}", d["verdict"]));
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(
+        bad.is_empty(),
+        "controls not fitted within the noise: {bad:?}"
+    );
+}

@@ -76,6 +76,16 @@ fn hoosier_qsx13_loads_with_an_mx_warning() {
         "{:#?}",
         t.warnings()
     );
+    // Its VERTICAL_STIFFNESS = 70 (N/m as read) would flatten it by 16 m at
+    // FNOMIN = 1112 N: a stiffness in other units (a rig run of it gave
+    // loaded radii of -16 m).
+    assert!(
+        t.warnings()
+            .iter()
+            .any(|w| w.starts_with("validation: VERTICAL_STIFFNESS")),
+        "{:#?}",
+        t.warnings()
+    );
     // The clean reference tyres carry no validation doubt.
     for f in [
         "PacejkaBook_Defaults.tir",

@@ -16,7 +16,9 @@
 //!   to FZMIN..FZMAX, κ over KPUMIN..KPUMAX, α over ALPMIN..ALPMAX, γ over
 //!   CAMMIN..CAMMAX) gives a non-finite value, a friction coefficient outside
 //!   [0, [`MU_MAX`]], a force |Fx|, |Fy| > [`FORCE_FACTOR`]·Fz·max(1, |μx|, |μy|)
-//!   or a moment |Mx|, |My|, |Mz| > [`MOMENT_FACTOR`]·Fz·R0·max(1, |μx|, |μy|).
+//!   or a moment |Mx|, |My|, |Mz| > [`MOMENT_FACTOR`]·Fz·R0·max(1, |μx|, |μy|);
+//!   a static deflection FNOMIN/VERTICAL_STIFFNESS beyond [`DEFLECTION_MAX`]
+//!   of the radius (a stiffness in N/mm or kN/m).
 //!
 //! The bounds: the Magic Formula's peak is D = μ·Fz (Pacejka, *Tyre and
 //! Vehicle Dynamics*, 3rd ed., eqs. 4.E9/4.E22), the vertical shifts add a few
@@ -41,6 +43,10 @@ pub const MU_MAX: f64 = 10.0;
 pub const RADIUS_RANGE: (f64, f64) = (0.01, 20.0);
 /// FNOMIN (N) a tyre can have; outside is refused (wrong `[UNITS]`).
 pub const LOAD_RANGE: (f64, f64) = (1.0, 1e7);
+
+/// Static deflection at FNOMIN, as a share of UNLOADED_RADIUS, beyond which
+/// VERTICAL_STIFFNESS is reported (tyres deflect by a few per cent).
+pub const DEFLECTION_MAX: f64 = 0.5;
 
 /// Road speeds (m/s) the grid is also evaluated at (walking pace to 216 km/h).
 pub const SPEEDS: [f64; 4] = [1.0, 10.0, 30.0, 60.0];
@@ -140,6 +146,23 @@ pub fn check(tyre: &Tyre) -> Result<Vec<String>, String> {
                 worst.add(&x, &tyre.evaluate(&x, mode), p.unloaded_radius);
             }
         }
+    }
+    // The static deflection at the nominal load, FNOMIN/Cz, is a few per
+    // cent of a tyre's radius; beyond half of it the file's stiffness is in
+    // other units (N/mm, kN/m) and every loaded radius, and in the FMU's
+    // vertical mode every load, computed from it is meaningless.
+    let deflection = p.fnomin / p.vertical_stiffness;
+    if p.vertical_stiffness > 0.0
+        && deflection.is_finite()
+        && deflection > DEFLECTION_MAX * p.unloaded_radius
+    {
+        warnings.push(format!(
+            "validation: VERTICAL_STIFFNESS = {} N/m deflects the tyre by {:.3} m at FNOMIN = {} N, \
+             more than {DEFLECTION_MAX} × UNLOADED_RADIUS = {} m: the value is likely in N/mm or \
+             kN/m; loaded radii and loads from deflection are not a tyre's — check the value and \
+             the [UNITS] section",
+            p.vertical_stiffness, deflection, p.fnomin, p.unloaded_radius
+        ));
     }
     if !(LONGVL_RANGE.0..=LONGVL_RANGE.1).contains(&p.longvl) {
         warnings.push(format!(

@@ -290,8 +290,9 @@ pub struct RadiusReestimated {
 /// re-centred, [`super::slip_channel`]). The baseline's stages were fitted
 /// on the recording's slip, computed through another radius; the finding
 /// changes the slip every sample sees (κ′ = (1 + κ)·Re_ext/Re_base − 1,
-/// [`rerolled`]), and the pure and Mz stages are fitted again on the
-/// recording with that κ′ from `ext`, whose radius keys the fit keeps
+/// [`rerolled`]), and the [`REESTIMATED_STAGES`] are fitted again on the
+/// recording (as fitted, [`Refit::fitted_on`]) with that κ′ from `ext`,
+/// whose radius keys the fit keeps
 /// ([`super::baseline::fit_baseline_from`] from a given start runs no
 /// geometry step). One round: there is no
 /// extension parameter to alternate with. Kept under the guards of

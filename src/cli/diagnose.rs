@@ -124,7 +124,9 @@ pub fn run(a: Args) -> Result<()> {
                 crate::fit::mf_fit::overall_sigma(&fit.report.metrics, ch)
                     .map_or("–".into(), |v| format!("{:.1} %", 100.0 * v))
             };
-            fitted_on = Some(merge(recs.clone()));
+            if !a.keep_baseline {
+                fitted_on = Some(merge(recs.clone()));
+            }
             let dropped = drop_unfitted(&mut recs, &fit);
             let mut note = format!(
                 "Baseline: steady MF 6.1 fitted to the recordings (every {}. sample; σ Fx {}, Fy {}, Mz {}), started from the built-in tyre with FNOMIN/NOMPRES/LONGVL from the data; each channel diagnosed on the segment kinds it was fitted on (Mz on cornering only); held (so the candidates can name them): relaxation lengths, pressure terms {} (0, data pooled at the median pressure), LMUV and all scaling factors, BREFF/DREFF/FREFF.",
@@ -167,13 +169,10 @@ pub fn run(a: Args) -> Result<()> {
         &rec,
         &tyre,
         &ReplayOptions::default(),
-        fitted_on
-            .as_ref()
-            .filter(|_| !a.keep_baseline)
-            .map(|r| Refit {
-                fit: &refit,
-                fitted_on: r,
-            }),
+        fitted_on.as_ref().map(|r| Refit {
+            fit: &refit,
+            fitted_on: r,
+        }),
         &mut step,
     )?;
     let mut base = tyre.params().clone();

@@ -13,6 +13,12 @@
 //! (28 Nov 2026) found the FSAE tyre's Fx at 3.98× — its PKX2 = −80 lay
 //! outside the fit's box (±50). This test's recording of it, box ±50: Fx
 //! 2.87×, Fy 2.31×, Mz 3.11× (fails); box ±200: 1.92×, 1.42×, 1.72×.
+//! The two PAC2002 tyres of FNOMIN 35 kN are here for the data-driven
+//! start's load bins: the rig's load ramps merged the sweeps' loads into
+//! one bin, no load trend was estimated and the fit stayed in the built-in
+//! tyre's basin — HMMWV Fx 39.4×, Mz 9.4×; Generic Fx 39.3×, Mz 9.1× (fails);
+//! with the ramps left out of the bins (`fit::initial`, RAMP_SHARE):
+//! 0.34×/1.30×/1.49× and 0.35×/1.36×/2.29×.
 //!
 //! What this does not show: the rig is the project's own, so it proves the
 //! fit's reach over real parameter sets, not the diagnosis's generality
@@ -28,7 +34,7 @@ use tyrekit::mf::Tyre;
 use tyrekit::rig::{effects, simulate, RigConfig};
 
 /// The tyres: (file, why it is here).
-const TYRES: [(&str, &str); 4] = [
+const TYRES: [(&str, &str); 6] = [
     ("FSAE_Defaults.tir", "MFeval's FSAE default; PKX2 = -80"),
     ("Sedan_Pac02Tire.tir", "PAC2002 car tyre; PEY4 = -760"),
     (
@@ -36,6 +42,14 @@ const TYRES: [(&str, &str); 4] = [
         "truck tyre, FNOMIN 21.7 kN, PDY1 < 0",
     ),
     ("MagicFormula52_Parameters.tir", "MF 5.2 car tyre"),
+    (
+        "HMMWV_Pac02Tire.tir",
+        "PAC2002 off-road tyre, FNOMIN 35 kN; needs the data-driven start's load bins",
+    ),
+    (
+        "Generic_Pac02Tire.tir",
+        "PAC2002 generic tyre; needs the data-driven start's load bins",
+    ),
 ];
 
 /// A control recording of `tyre`: the rig's standard programme at one

@@ -656,7 +656,7 @@ pub fn gather(
         meas: vec![Vec::new(); channels.len()],
         ..Default::default()
     };
-    let (mut gmin, mut gmax, mut pmin, mut pmax) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    let (mut gammas, mut pressures) = (Vec::new(), Vec::new());
     for (r, rec) in recs.iter().enumerate() {
         let keep = |i: usize| train.is_none_or(|t| t[r].iter().any(|rg| rg.contains(&i)));
         for seg in rec.segments.iter().filter(|s| s.kind == kind) {
@@ -676,18 +676,38 @@ pub fn gather(
                 for (k, c) in channels.iter().enumerate() {
                     d.meas[k].push(c.measured(s));
                 }
-                gmin = gmin.min(s.gamma);
-                gmax = gmax.max(s.gamma);
+                gammas.push(s.gamma);
                 if s.p.is_finite() && s.p > 0.0 {
-                    pmin = pmin.min(s.p);
-                    pmax = pmax.max(s.p);
+                    pressures.push(s.p);
                 }
             }
         }
     }
-    d.gamma_spread = (gmax - gmin).max(0.0);
-    d.p_spread = (pmax - pmin).max(0.0);
+    d.gamma_spread = robust_spread(&mut gammas);
+    d.p_spread = robust_spread(&mut pressures);
     d
+}
+
+/// Share of samples left out at each end of [`robust_spread`].
+const SPREAD_TAIL: f64 = 0.01;
+
+/// The spread of `v` between its 1st and 99th percentiles (0 when empty):
+/// the conditions a stage's data cover, not a few stray samples. On a rig
+/// control of MFeval's FSAE tyre the upright drive/brake segments (0 ±
+/// 0.04°) held samples up to 1.0° where a block's inclination changed:
+/// max − min passed [`CAMBER_SPREAD`] and freed camber terms the data
+/// cannot determine (PDX3 at its bound −50, standard error 10⁴). A
+/// condition held by at least 1 % of the samples still counts.
+fn robust_spread(v: &mut [f64]) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    let n = v.len();
+    let lo_at = ((n - 1) as f64 * SPREAD_TAIL) as usize;
+    let hi_at = ((n - 1) as f64 * (1.0 - SPREAD_TAIL)).ceil() as usize;
+    let lo = *v.select_nth_unstable_by(lo_at, f64::total_cmp).1;
+    let hi = *v.select_nth_unstable_by(hi_at.min(n - 1), f64::total_cmp).1;
+    (hi - lo).max(0.0)
 }
 
 /// One channel of a Magic Formula stage as a least-squares [`Problem`]:
@@ -1078,5 +1098,32 @@ impl Problem for MfStage<'_> {
     }
     fn threads(&self) -> usize {
         self.threads
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Inclinations as the rig control of the FSAE tyre recorded them in its
+    /// drive/brake segments: upright with ±0.04° noise and a few samples at
+    /// 1° where a block's inclination changed. The spread must stay below
+    /// [`CAMBER_SPREAD`] (camber terms held), while a second level held by
+    /// 2 % of the samples (a short camber block) must count.
+    #[test]
+    fn robust_spread_ignores_stray_samples_not_short_blocks() {
+        let noise = |i: usize| 0.0007 * ((i * 7919 % 1000) as f64 / 500.0 - 1.0);
+        let mut upright: Vec<f64> = (0..4000).map(noise).collect();
+        upright.extend([0.0177; 20]); // 0.5 % of the samples at 1°
+        let s = robust_spread(&mut upright);
+        assert!(s < CAMBER_SPREAD, "stray samples set the spread: {s}");
+        let mut two: Vec<f64> = (0..4000).map(noise).collect();
+        two.extend((0..80).map(|i| 2f64.to_radians() + noise(i))); // 2 %
+        let s = robust_spread(&mut two);
+        assert!(
+            (s - 2f64.to_radians()).abs() < 0.002,
+            "a 2 % block at 2° not seen: spread {s}"
+        );
+        assert_eq!(robust_spread(&mut []), 0.0);
     }
 }

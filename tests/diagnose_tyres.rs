@@ -19,7 +19,7 @@
 //! one bin, no load trend was estimated and the fit stayed in the built-in
 //! tyre's basin — HMMWV Fx 39.4×, Mz 9.4×; Generic Fx 39.3×, Mz 9.1× (fails);
 //! with the ramps left out of the bins (`fit::initial`, RAMP_SHARE):
-//! 0.34×/1.30×/1.49× and 0.35×/1.36×/2.29×.
+//! 0.34×/1.30×/1.49× and 0.35×/1.35×/2.21×.
 //!
 //! What this does not show: the rig is the project's own, so it proves the
 //! fit's reach over real parameter sets, not the diagnosis's generality

@@ -1,5 +1,5 @@
 //! stats — the order statistics the data, fit and diagnose stages share
-//! (one median, not one per module).
+//! (one median, one quantile, not one per module).
 //!
 //! Must never: panic on empty or non-finite input, or allocate when given a
 //! slice to work in.
@@ -27,6 +27,18 @@ pub(crate) fn median_in_place(v: &mut [f64]) -> f64 {
     *v.select_nth_unstable_by(m, f64::total_cmp).1
 }
 
+/// The `q`-quantile of `v` (0 ≤ q ≤ 1, clamped): the element of rank
+/// round((n − 1)·q) in sorted order (nearest rank, a value the data hold),
+/// reordering `v` in place (no allocation); NaN when empty. Non-finite
+/// values count as values, as in [`median_in_place`].
+pub(crate) fn quantile_in_place(v: &mut [f64], q: f64) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    let k = ((v.len() - 1) as f64 * q.clamp(0.0, 1.0)).round() as usize;
+    *v.select_nth_unstable_by(k, f64::total_cmp).1
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -40,5 +52,16 @@ mod tests {
         let mut v = [5.0, -1.0, 2.0];
         assert_eq!(median_in_place(&mut v), 2.0);
         assert!(median_in_place(&mut []).is_nan());
+    }
+
+    #[test]
+    fn nearest_rank_quantiles() {
+        let mut v: Vec<f64> = (1..=101).rev().map(f64::from).collect();
+        assert_eq!(quantile_in_place(&mut v, 0.0), 1.0);
+        assert_eq!(quantile_in_place(&mut v, 0.01), 2.0);
+        assert_eq!(quantile_in_place(&mut v, 0.5), 51.0);
+        assert_eq!(quantile_in_place(&mut v, 0.99), 100.0);
+        assert_eq!(quantile_in_place(&mut v, 1.5), 101.0);
+        assert!(quantile_in_place(&mut [], 0.5).is_nan());
     }
 }

@@ -702,11 +702,8 @@ fn robust_spread(v: &mut [f64]) -> f64 {
     if v.is_empty() {
         return 0.0;
     }
-    let n = v.len();
-    let lo_at = ((n - 1) as f64 * SPREAD_TAIL) as usize;
-    let hi_at = ((n - 1) as f64 * (1.0 - SPREAD_TAIL)).ceil() as usize;
-    let lo = *v.select_nth_unstable_by(lo_at, f64::total_cmp).1;
-    let hi = *v.select_nth_unstable_by(hi_at.min(n - 1), f64::total_cmp).1;
+    let lo = crate::stats::quantile_in_place(v, SPREAD_TAIL);
+    let hi = crate::stats::quantile_in_place(v, 1.0 - SPREAD_TAIL);
     (hi - lo).max(0.0)
 }
 

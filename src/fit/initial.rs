@@ -94,7 +94,7 @@ pub fn estimate(
             || cell(idx[j]) > cell(idx[j - 1]) + 1;
         if split {
             if j - lo >= BIN_MIN {
-                if let Some(b) = bin(&idx[lo..j], &|i| slip(i), y, &|i| data.conds[i].fz, lateral) {
+                if let Some(b) = bin(&idx[lo..j], &|i| slip(i), y, &fz, lateral) {
                     bins.push(b);
                 }
             }

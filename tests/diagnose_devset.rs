@@ -228,7 +228,7 @@ fn run(a: &Answer, dir: &Path, data: &Path) -> Outcome {
 fn outcomes() -> Option<&'static Vec<Outcome>> {
     static CELL: OnceLock<Option<Vec<Outcome>>> = OnceLock::new();
     CELL.get_or_init(|| {
-        let v = devset::run_all("diagnose_devset", |a, work, dir| run(a, work, dir))?;
+        let v = devset::run_all("diagnose_devset", run)?;
         print_table(&v);
         Some(v)
     })

@@ -97,8 +97,7 @@ fn check_re(path: &str, lateral_only: bool) {
         // The last such line: [UNITS] has a MASS line of its own.
         let line = text
             .lines()
-            .filter(|l| l.starts_with(k) && l[k.len()..].trim_start().starts_with('='))
-            .last()
+            .rfind(|l| l.starts_with(k) && l[k.len()..].trim_start().starts_with('='))
             .unwrap();
         assert!(line.contains("$ NOT DETERMINED"), "{line}");
     }

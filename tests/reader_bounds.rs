@@ -152,7 +152,7 @@ fn mat_decompression_bomb_is_refused_early() {
     let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::fast());
     z.write_all(&el).unwrap();
     let zeros = vec![0u8; 1 << 20];
-    for _ in 0..(n * 8 >> 20) {
+    for _ in 0..((n * 8) >> 20) {
         z.write_all(&zeros).unwrap();
     }
     let zb = z.finish().unwrap();
@@ -162,7 +162,7 @@ fn mat_decompression_bomb_is_refused_early() {
     eprintln!(
         "bomb .mat: {} bytes, inflates to {} MB",
         f.len(),
-        n * 8 >> 20
+        (n * 8) >> 20
     );
     let p = write("bomb.mat", &f);
     let rss = check("mat bomb", &["data", "summary", s(&p)], true);

@@ -129,10 +129,8 @@ fn tread_temperature_heats_with_friction_power_and_resets() {
         s.set("SHARE", share);
         s.set("MU_T1", -0.2);
     });
-    assert!(
-        SLOT_TEMP < N_STATES,
-        "the temperature must be a serialised slot"
-    );
+    // The temperature must be a serialised slot (checked at compile time).
+    const _: () = assert!(SLOT_TEMP < N_STATES);
     let mut m = model(TransientKind::Steady, InputMode::Slips);
     let inp = slips(15.0, 0.0, 0.1);
     let first = m.step(&ext, &inp, 0.01).unwrap();

@@ -125,9 +125,7 @@ fn keys_the_model_divides_by_are_refused_when_zero_or_negative() {
 #[test]
 fn wrong_units_are_refused_or_warned() {
     // LENGTH = 'mm' on a file written in metres: R0 = 0.3 mm, no tyre.
-    let e = load("LENGTH", "LENGTH = 'mm'")
-        .err()
-        .expect("mm radius loaded");
+    let e = load("LENGTH", "LENGTH = 'mm'").expect_err("mm radius loaded");
     assert!(
         e.contains("UNLOADED_RADIUS") && e.contains("[UNITS]"),
         "{e}"

@@ -257,6 +257,7 @@ struct ReFit {
 
 /// `a_fixed`: Rω at zero load given (the loaded radius's zero-load
 /// intercept: in the MF both radii start from the same Rω).
+#[allow(clippy::too_many_arguments)] // the Re(Fz) form's switches, read at one call site
 fn fit_re(
     free: &[Free],
     r0: f64,
@@ -341,7 +342,7 @@ fn free_rolling_fx(
         let fmax = r.samples.iter().map(|s| s.fz).fold(0.0, f64::max);
         let sr = r.extra("SR");
         for (i, s) in r.samples.iter().enumerate() {
-            let sr_ok = sr.map_or(true, |v| !v[i].is_finite() || v[i].abs() < 0.01);
+            let sr_ok = sr.is_none_or(|v| !v[i].is_finite() || v[i].abs() < 0.01);
             if s.fz > 0.1 * fmax
                 && s.alpha.abs() < lim
                 && s.fx.is_finite()

@@ -247,7 +247,7 @@ impl Worst {
             return;
         }
         for (n, mu) in [("mux", o.mux), ("muy", o.muy)] {
-            if !(mu >= 0.0 && mu <= MU_MAX) && self.mu.is_none() {
+            if !(0.0..=MU_MAX).contains(&mu) && self.mu.is_none() {
                 self.mu = Some((mu, n, *x));
             }
         }

@@ -351,7 +351,6 @@ pub const LUGRE_FRICTION_MARGIN: f64 = 1.05;
 
 /// One LuGre step (see the module docs); updates slots 0, 1 of `st`.
 /// |F_i| ≤ [`LUGRE_FRICTION_MARGIN`]·max(μ_i·Fz, |F_i,MF|) in any slip history.
-
 pub(crate) fn step(c: &StepCtx, p: &LuGreParams, st: &mut TransientState, dt: f64) -> WheelOutput {
     let fz = c.fz;
     let vrx = -c.kin.vsx;

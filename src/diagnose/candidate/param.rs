@@ -233,6 +233,12 @@ impl Param {
     }
 }
 
+/// A condition's value on one segment (pressure, inclination): see [`Spec::levels`].
+pub type SegmentValue = fn(&crate::data::Segment) -> f64;
+
+/// Fixed values a candidate takes from the fit half: see [`Spec::from_data`].
+pub type FromData = fn(&Recording, &[bool]) -> Option<Vec<(Target, f64)>>;
+
 /// How a parametrised candidate applies to one baseline tyre.
 #[derive(Clone, Debug, Default)]
 pub struct Spec {
@@ -256,7 +262,7 @@ pub struct Spec {
     /// candidate is fitted only when the fit half spans at least two levels
     /// — at one pressure the pressure terms can only fit sensor noise on the
     /// recorded pressure and end at a bound.
-    pub levels: Option<(fn(&crate::data::Segment) -> f64, f64)>,
+    pub levels: Option<(SegmentValue, f64)>,
     /// Further start points (parameter name, start value overriding
     /// [`Param::init`]): LM runs from the plain start and from each of
     /// these, and the fit with the lowest fit-half cost is kept — for a
@@ -272,7 +278,7 @@ pub struct Spec {
     /// [`Spec::fixed`]), e.g. the knot loads of a curve over the recorded
     /// load range; None from the function: the fit half cannot carry the
     /// candidate (one load level), which is then the baseline itself.
-    pub from_data: Option<fn(&Recording, &[bool]) -> Option<Vec<(Target, f64)>>>,
+    pub from_data: Option<FromData>,
     /// The parameters are separate terms, each of which the physics may
     /// lack (the knot values of the load curves, the camber terms): after
     /// the full fit,

@@ -110,7 +110,7 @@ pub fn split(rec: &Recording) -> (Vec<bool>, Vec<bool>) {
         let k = (format!("{:?}", g.kind), bin(g.fz, fz_bin));
         let ord = groups.len();
         let e = groups.entry(k).or_insert((ord, 0));
-        is_fit.push((e.0 + e.1) % 2 == 0);
+        is_fit.push((e.0 + e.1).is_multiple_of(2));
         e.1 += 1;
     }
     for f in 0..3 {
@@ -246,6 +246,9 @@ pub fn fit_weights(rec: &Recording, base: &[Forces], mask: &[bool]) -> [f64; 3] 
 /// n/50 used before.)
 pub const DECORRELATION_TIME: f64 = 1.0;
 
+/// One candidate's outcome, by its index in the catalogue.
+type Scored = (usize, Result<(Evaluation, Box<dyn Fitted>)>);
+
 /// Fit every candidate on the fit half, score on the other (see the module
 /// docs), all on the recording with smoothed inputs ([`smoothed_inputs`]).
 /// Two threads. Sorted best first (held-out gain).
@@ -308,7 +311,7 @@ pub fn evaluate(
     };
     let gain = |b: f64, x: f64| if b > 0.0 { 1.0 - x / b } else { 0.0 };
     let next = std::sync::atomic::AtomicUsize::new(0);
-    let run = || -> Vec<(usize, Result<(Evaluation, Box<dyn Fitted>)>)> {
+    let run = || -> Vec<Scored> {
         let mut got = Vec::new();
         loop {
             let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -360,13 +363,12 @@ pub fn evaluate(
         }
         got
     };
-    let mut results: Vec<(usize, Result<(Evaluation, Box<dyn Fitted>)>)> =
-        std::thread::scope(|s| {
-            let h = s.spawn(run);
-            let mut mine = run();
-            mine.extend(h.join().unwrap_or_default());
-            mine
-        });
+    let mut results: Vec<Scored> = std::thread::scope(|s| {
+        let h = s.spawn(run);
+        let mut mine = run();
+        mine.extend(h.join().unwrap_or_default());
+        mine
+    });
     results.sort_by_key(|(i, _)| *i);
     let mut out = Vec::with_capacity(results.len());
     for (_, r) in results {

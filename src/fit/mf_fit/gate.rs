@@ -141,42 +141,6 @@ fn choose(j0: &Judged, cands: &[&Judged]) -> Option<usize> {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn j(pure: &[f64], score: f64) -> Judged {
-        Judged {
-            pure: pure.to_vec(),
-            score,
-        }
-    }
-
-    /// r04/r07 of the dev set gave these shapes: the stage alone raises
-    /// pure Mz (×2.2, ×3.1 in mean square) at a better score; the re-polish
-    /// keeps the pure rows. The rule must take the re-polish, not the
-    /// lowest score; and when both raise a pure channel, the lowest score
-    /// only if it beats the tyre before.
-    #[test]
-    fn a_stage_may_not_spoil_the_pure_rows() {
-        let before = j(&[1.0, 1.0, 1.0], 0.37);
-        let stage = j(&[0.98, 1.06, 2.16], 0.030);
-        let polished = j(&[1.0, 0.99, 0.91], 0.036);
-        assert_eq!(choose(&before, &[&stage, &polished]), Some(1));
-        // Both raise Fy: the better score wins if it beats the tyre before…
-        let polished = j(&[1.0, 1.09, 0.94], 0.0081);
-        let before = j(&[1.0, 1.0, 1.0], 0.0084);
-        let stage = j(&[1.0, 1.15, 3.05], 0.0216);
-        assert_eq!(choose(&before, &[&stage, &polished]), Some(1));
-        // …and the tyre before is kept when it scores best.
-        let before = j(&[1.0, 1.0, 1.0], 0.0080);
-        assert_eq!(choose(&before, &[&stage, &polished]), None);
-        // A rise within TOL is not a rise.
-        let before = j(&[1.0], 1.0);
-        assert_eq!(choose(&before, &[&j(&[1.0 + 0.5 * TOL], 0.5)]), Some(0));
-    }
-}
-
 /// Decide the combined stage: candidates `after` (the stage's result) and
 /// `after` with the `pure` stages re-polished from its values; `before` the
 /// tyre the stage started from. Returns the kept tyre, the outcomes of the
@@ -244,4 +208,40 @@ pub(crate) fn accept_combined(
             note("the tyre before it (its judged score is the least)"),
         ),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn j(pure: &[f64], score: f64) -> Judged {
+        Judged {
+            pure: pure.to_vec(),
+            score,
+        }
+    }
+
+    /// r04/r07 of the dev set gave these shapes: the stage alone raises
+    /// pure Mz (×2.2, ×3.1 in mean square) at a better score; the re-polish
+    /// keeps the pure rows. The rule must take the re-polish, not the
+    /// lowest score; and when both raise a pure channel, the lowest score
+    /// only if it beats the tyre before.
+    #[test]
+    fn a_stage_may_not_spoil_the_pure_rows() {
+        let before = j(&[1.0, 1.0, 1.0], 0.37);
+        let stage = j(&[0.98, 1.06, 2.16], 0.030);
+        let polished = j(&[1.0, 0.99, 0.91], 0.036);
+        assert_eq!(choose(&before, &[&stage, &polished]), Some(1));
+        // Both raise Fy: the better score wins if it beats the tyre before…
+        let polished = j(&[1.0, 1.09, 0.94], 0.0081);
+        let before = j(&[1.0, 1.0, 1.0], 0.0084);
+        let stage = j(&[1.0, 1.15, 3.05], 0.0216);
+        assert_eq!(choose(&before, &[&stage, &polished]), Some(1));
+        // …and the tyre before is kept when it scores best.
+        let before = j(&[1.0, 1.0, 1.0], 0.0080);
+        assert_eq!(choose(&before, &[&stage, &polished]), None);
+        // A rise within TOL is not a rise.
+        let before = j(&[1.0], 1.0);
+        assert_eq!(choose(&before, &[&j(&[1.0 + 0.5 * TOL], 0.5)]), Some(0));
+    }
 }

@@ -5,13 +5,13 @@
 //! 28(11), 2006; brush: Pacejka, *Tyre and Vehicle Dynamics*, 3rd ed., ch. 3;
 //! carcass: the stretched string, Pacejka ch. 5).
 //!
-//! The patch is discretised into M points ([`contact`]: length from load and
+//! The patch is discretised into M points (`contact`: length from load and
 //! vertical stiffness, parabolic or generalised pressure); the tread is a
 //! shear spring per point (c_px, c_py per unit length); the carcass' lateral
-//! compliance is the string's Green's function ([`carcass`], derivation in
+//! compliance is the string's Green's function (`carcass`, derivation in
 //! its header); adhesion where the force needed stays below μs·p, sliding
 //! with μk behind the first sliding point, the boundary iterated until it no
-//! longer moves ([`solver`]). Outputs Fx, Fy, Mz (ISO-W) for pure and
+//! longer moves (`solver`). Outputs Fx, Fy, Mz (ISO-W) for pure and
 //! combined slip (Pacejka's theoretical slips, sliding along the slip), the
 //! cornering stiffness of the paper's eq. (14) and the slip stiffness.
 //! Camber is not modelled: the brush's camber thrust (the tread following
@@ -21,7 +21,7 @@
 //! are those of γ = 0.
 //!
 //! Parameters: `[BRUSH]` section of the `.tir`, defaults from the file's
-//! Magic Formula ([`params`]). Selectable as the force model of the
+//! Magic Formula (`params`). Selectable as the force model of the
 //! transient models (`TransientOptions::brush`), in `eval`/`replay`
 //! (`--force-model brush`), the FMU (`force_model = brush`), fitted by
 //! `fit --model brush` (`crate::fit::brush`); the paper's study of tread
@@ -78,7 +78,7 @@ impl ForceModelKind {
 }
 
 impl BrushParams {
-    /// Fx, Fy, Mz at one operating point (allocation-free; see [`solver`]).
+    /// Fx, Fy, Mz at one operating point (allocation-free; see `solver`).
     #[inline]
     pub fn forces(&self, inp: &BrushInput) -> BrushForces {
         solver::evaluate(self, inp)

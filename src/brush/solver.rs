@@ -221,7 +221,7 @@ pub fn evaluate(p: &BrushParams, inp: &BrushInput) -> BrushForces {
     evaluate_on(p, &patch, inp)
 }
 
-/// [`evaluate`] on a given patch (the fitter and the study reuse one patch per load).
+/// `evaluate` on a given patch (the fitter and the study reuse one patch per load).
 pub fn evaluate_on(p: &BrushParams, patch: &Patch, inp: &BrushInput) -> BrushForces {
     let (mu_s, mu_k) = friction(p, inp.fz, inp.mu_scale);
     let m = patch.m;

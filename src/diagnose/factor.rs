@@ -34,7 +34,7 @@ const MIN_SEGMENT_SAMPLES: usize = 10;
 /// standard deviation of `get` about a straight line in time within the
 /// segment (a set point held, or a slow drift, leaves only the noise; the
 /// median keeps a few segments with a step inside from inflating it).
-/// NaN when no segment has [`MIN_SEGMENT_SAMPLES`] finite values.
+/// NaN when no segment has `MIN_SEGMENT_SAMPLES` finite values.
 pub fn noise(samples: &[Sample], segments: &[&Segment], get: fn(&Sample) -> f64) -> f64 {
     let mut sd: Vec<f64> = segments
         .iter()

@@ -290,7 +290,7 @@ pub struct RadiusReestimated {
 /// re-centred, [`super::slip_channel`]). The baseline's stages were fitted
 /// on the recording's slip, computed through another radius; the finding
 /// changes the slip every sample sees (κ′ = (1 + κ)·Re_ext/Re_base − 1,
-/// [`rerolled`]), and the [`REESTIMATED_STAGES`] are fitted again on the
+/// `rerolled`), and the [`REESTIMATED_STAGES`] are fitted again on the
 /// recording (as fitted, [`Refit::fitted_on`]) with that κ′ from `ext`,
 /// whose radius keys the fit keeps
 /// ([`super::baseline::fit_baseline_from`] from a given start runs no

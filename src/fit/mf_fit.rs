@@ -43,7 +43,7 @@ pub struct MfFitOptions {
     /// The start tyre is a generic one (the built-in), not a file of the
     /// tyre under test: coefficients the data cannot determine and that
     /// have a neutral value are held at it rather than at another tyre's
-    /// ([`NEUTRAL_SLIP_ANGLE_SHAPE`]). `tyrekit fit --start` turns it off.
+    /// (`NEUTRAL_SLIP_ANGLE_SHAPE`). `tyrekit fit --start` turns it off.
     pub generic_start: bool,
     /// Fit the radii and vertical stiffness keys to the recorded Re and Rl
     /// before the force stages ([`super::geometry`]; R0 enters the Mz, Mx,
@@ -128,7 +128,7 @@ pub struct MfFit {
     /// Stages skipped and why.
     pub skipped: Vec<String>,
     /// Which candidate of a gated stage was kept and the figures that decided
-    /// it ([`gate`]).
+    /// it (`gate`).
     pub decisions: Vec<String>,
     /// Per recording: the (train, held-out) sample ranges.
     pub splits: Vec<TrainTest>,

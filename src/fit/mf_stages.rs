@@ -278,7 +278,7 @@ impl StageData {
 pub const COARSE_SAMPLES: usize = 10_000;
 
 /// Size of the subsample the starts of a multi-start stage race on
-/// ([`best_start`]; stages with more than twice this many samples use every
+/// (`best_start`; stages with more than twice this many samples use every
 /// k-th sample with k = m / `RACE_SAMPLES`). The race only decides which
 /// basin the winner comes from — it is judged on the full data and then
 /// converged on the [`COARSE_SAMPLES`] subsample and the full data — so it
@@ -326,7 +326,7 @@ pub fn fit_stage(
 
 /// [`fit_stage`] from the parameters' start and the `extra_starts` (θ
 /// vectors over `params`): the candidate with the least full-data cost after
-/// converging on the subsample is polished ([`best_start`]).
+/// converging on the subsample is polished (`best_start`).
 #[allow(clippy::too_many_arguments)]
 pub fn fit_stage_from(
     form: Form,
@@ -491,7 +491,7 @@ pub fn fit_stage_from(
     )
 }
 
-/// Most LM iterations per round of one start in [`best_start`]: the starts
+/// Most LM iterations per round of one start in `best_start`: the starts
 /// race, and the winner is polished to convergence afterwards, so the limit
 /// decides only which start wins when one of them crawls: a start still
 /// descending after 50 steps on the subsample is then judged where it

@@ -153,7 +153,7 @@ pub struct Thermal {
     pub cooling: f64,
     /// Share q of the frictional power heating the tread (–).
     pub share: f64,
-    /// Friction polynomial in x = ΔT/50 K: s = 1 + mu[0] + mu[1]·x + mu[2]·x².
+    /// Friction polynomial in x = ΔT/50 K: `s = 1 + mu[0] + mu[1]·x + mu[2]·x²`.
     pub mu: [f64; 3],
 }
 

@@ -345,7 +345,7 @@ fn elastoplastic(z: f64, zss: f64, vr: f64, beta: f64) -> f64 {
 }
 
 /// LuGre forces never exceed this multiple of the friction limit
-/// max(μ_i·Fz, |F_i,MF|) per direction (see [`step`]); μ_i is the Stribeck
+/// max(μ_i·Fz, |F_i,MF|) per direction (see `step`); μ_i is the Stribeck
 /// peak max(μs, μc) with the own Stribeck curve, else the MF's μ_i·max(1, μs).
 pub const LUGRE_FRICTION_MARGIN: f64 = 1.05;
 

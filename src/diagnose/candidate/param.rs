@@ -283,7 +283,7 @@ pub struct Spec {
     /// lack (the knot values of the load curves, the camber terms): after
     /// the full fit,
     /// drop them one at a time while that lowers the fit half's evidence
-    /// statistic ([`eliminate`]), holding a dropped one at its start value.
+    /// statistic (`eliminate`), holding a dropped one at its start value.
     pub eliminate: bool,
 }
 
@@ -570,7 +570,7 @@ fn eliminate(
     (keep, theta)
 }
 
-/// A candidate fitted by Levenberg–Marquardt ([`fit_lm`]) over the parameters of a
+/// A candidate fitted by Levenberg–Marquardt (`fit_lm`) over the parameters of a
 /// [`Spec`] (built per baseline tyre; None: not applicable to that tyre, the
 /// fit is then the baseline itself).
 pub struct ParamCandidate {

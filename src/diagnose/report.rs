@@ -29,8 +29,8 @@
 
 use super::candidate::param::rerolled;
 use super::candidate::{
-    all, also_qualifying, channels_in_words, evaluate, refit_on_all, select, why_not, Candidate,
-    ChannelScore, Evaluation,
+    all, also_qualifying, channels_in_words, evaluate, overshadowed_in_words, overshadowed_summary,
+    refit_on_all, select, why_not, Candidate, ChannelScore, Evaluation,
 };
 use super::locate::{frictional_energy, locate, Finding, LocateOptions, Residuals};
 use super::reestimate::{beneath_rolling_radius, reestimate, Refit};
@@ -797,10 +797,11 @@ pub fn diagnose_with(
                 if e.name == "none" {
                     String::new()
                 } else {
-                    why_not(e).map_or_else(
-                        || ". Qualifies as a verdict".to_string(),
-                        |w| format!(". Not named: {w}"),
-                    )
+                    match (why_not(e), overshadowed_in_words(&ev, i)) {
+                        (Some(w), _) => format!(". Not named: {w}"),
+                        (None, Some(w)) => format!(". Qualifies, but is not named: {w}"),
+                        (None, None) => ". Qualifies as a verdict".to_string(),
+                    }
                 },
                 at_bound_note(e)
             ),
@@ -823,6 +824,10 @@ pub fn diagnose_with(
     let fit_mask = mask(&fit_r);
     let base_fit = baseline_fit(rec, &base.sim, &fit_mask, &test_mask);
     let mut explanation = explain(&findings, verdict_i.map(|i| &ev[i].0), best_other, alpha);
+    // A qualifier another candidate overshadows is not named: say which, and why.
+    if let Some(w) = overshadowed_summary(&ev) {
+        explanation.push_str(&format!(" {w}"));
+    }
     if verdict_i.is_none() && !slip_verdict {
         if let Some(m) = misfit_note(&base_fit) {
             explanation = format!("{m} {explanation}");

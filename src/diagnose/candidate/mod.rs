@@ -67,7 +67,9 @@
 //!   by more than [`MAX_LOSS`] (physics that is missing makes no channel
 //!   worse; a candidate that trades one channel for another absorbs a
 //!   misfit), and the pooled held-out and in-sample gains are positive;
-//!   among those the lowest pooled BIC wins, otherwise `none`. The held-out
+//!   among those the lowest pooled BIC wins, otherwise `none` — unless a
+//!   candidate that does not qualify removes more than [`OVERSHADOW`] times
+//!   as much of the winner's evidence channel ([`overshadowed`]). The held-out
 //!   test keeps over-fitting out, the channel's BIC asks for evidence in
 //!   proportion to the parameters and the seconds of data, and the pooled
 //!   BIC then prefers the fewer parameters between explanations that
@@ -101,7 +103,8 @@ mod thermal;
 pub use crate::residual::{FX, FY, MZ};
 pub use param::{NoneCandidate, Param, ParamCandidate, Spec, Target, STATIC_SAMPLES};
 pub use selection::{
-    also_qualifying, channels_in_words, qualifies, select, why_not, MAX_LOSS, MIN_GAIN,
+    also_qualifying, channels_in_words, overshadowed, overshadowed_in_words, overshadowed_summary,
+    qualifies, select, why_not, MAX_LOSS, MIN_GAIN, OVERSHADOW,
 };
 pub use statistics::{
     evaluate, every_segment, fit_weights, held_out_sse, refit_on_all, smoothed_inputs, split,

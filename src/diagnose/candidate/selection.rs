@@ -4,9 +4,11 @@
 //!
 //! Must never: name an effect that makes any channel's held-out error worse
 //! by more than [`MAX_LOSS`], or one without a channel whose held-out gain
-//! exceeds [`MIN_GAIN`] and whose own BIC falls.
+//! exceeds [`MIN_GAIN`] and whose own BIC falls, or one whose gain another
+//! candidate dwarfs in the same channel ([`OVERSHADOW`]).
 
 use super::{ChannelScore, Evaluation, Fitted};
+use crate::residual::Channel;
 
 /// Smallest held-out gain (share of the baseline's held-out squared error
 /// removed) in the channel that names an effect: below it the improvement
@@ -23,6 +25,19 @@ pub const MIN_GAIN: f64 = 0.02;
 /// TyreData: a 2.7 m relaxation length halves Fy's accuracy to gain on the
 /// badly fitted Mz), which no missing physics does.
 pub const MAX_LOSS: f64 = 0.05;
+
+/// How many times more of a channel's held-out error a candidate that does
+/// not qualify must remove than a qualifier does there to overshadow it.
+/// A qualifier names physics only when it is the best account of the
+/// structure it removes: when another mechanism removes more than twice as
+/// much of the same channel — and is not named itself because it spoils
+/// another channel — the qualifier is removing a fragment of a larger
+/// structure that no candidate models cleanly (a temperature effect that a
+/// friction curve cannot follow in every channel, read by a load curve as
+/// a few per cent of Mz), and its name would mislead. Twice: the gains of
+/// two mechanisms that fit the same structure differ by tens of per cent,
+/// not by a factor (relaxation against LuGre on a lag).
+pub const OVERSHADOW: f64 = 2.0;
 
 /// Whether channel `c` shows the effect: its held-out error falls by more
 /// than [`MIN_GAIN`] and its own BIC falls.
@@ -51,12 +66,108 @@ pub fn qualifies(e: &Evaluation) -> bool {
 /// BIC wins (parsimony between physics that generalise alike, e.g.
 /// relaxation against LuGre on a lag: the held-out gains differ by a few %
 /// where the extra parameter buys them).
+///
+/// A qualifier that another candidate overshadows ([`overshadowed`]) is not
+/// named.
 pub fn select(ev: &[(Evaluation, Box<dyn Fitted>)]) -> Option<usize> {
     ev.iter()
         .enumerate()
-        .filter(|(_, (e, _))| qualifies(e))
+        .filter(|&(i, (e, _))| qualifies(e) && overshadowed(ev, i).is_none())
         .min_by(|a, b| a.1 .0.delta_bic.total_cmp(&b.1 .0.delta_bic))
         .map(|(i, _)| i)
+}
+
+/// The candidate that overshadows qualifier `i` ([`OVERSHADOW`]), and the
+/// channel: one that does not qualify, removes more of the pooled held-out
+/// error than `i`, and more than [`OVERSHADOW`] times `i`'s held-out gain
+/// in a channel where `i` shows the effect. None when `i` does not
+/// qualify or nothing overshadows it.
+pub fn overshadowed(ev: &[(Evaluation, Box<dyn Fitted>)], i: usize) -> Option<(usize, Channel)> {
+    let q = &ev.get(i)?.0;
+    if !qualifies(q) {
+        return None;
+    }
+    q.channels.iter().filter(|c| shows(c)).find_map(|c| {
+        ev.iter().enumerate().find_map(|(j, (e, _))| {
+            let other = e.channels.iter().find(|o| o.channel == c.channel)?;
+            (j != i
+                && e.name != "none"
+                && e.n_params > 0
+                && !qualifies(e)
+                && e.oos_gain > q.oos_gain
+                && other.oos_gain > OVERSHADOW * c.oos_gain)
+                .then_some((j, c.channel))
+        })
+    })
+}
+
+/// Held-out gain of `e` in channel `ch`, in per cent (NaN without data).
+fn gain_in(e: &Evaluation, ch: Channel) -> f64 {
+    e.channels
+        .iter()
+        .find(|c| c.channel == ch)
+        .map_or(f64::NAN, |c| 100.0 * c.oos_gain)
+}
+
+/// Why qualifier `i` is not named though it qualifies ([`overshadowed`]),
+/// in words; None when nothing overshadows it.
+pub fn overshadowed_in_words(ev: &[(Evaluation, Box<dyn Fitted>)], i: usize) -> Option<String> {
+    let (j, ch) = overshadowed(ev, i)?;
+    let (q, s) = (&ev[i].0, &ev[j].0);
+    Some(format!(
+        "{} removes {:.1} % of the held-out {} error, {} removes {:.1} % of it (more than {:.0}× as much) and is itself not named ({}): what {} removes is part of a larger structure that no candidate models cleanly",
+        q.name,
+        gain_in(q, ch),
+        ch.name(),
+        s.name,
+        gain_in(s, ch),
+        OVERSHADOW,
+        why_not(s).unwrap_or_default(),
+        q.name
+    ))
+}
+
+/// The overshadowed qualifiers of `ev` ([`overshadowed`]) in one sentence
+/// per overshadowing candidate; None when there are none.
+pub fn overshadowed_summary(ev: &[(Evaluation, Box<dyn Fitted>)]) -> Option<String> {
+    let pairs: Vec<(usize, usize, Channel)> = (0..ev.len())
+        .filter_map(|i| overshadowed(ev, i).map(|(j, ch)| (i, j, ch)))
+        .collect();
+    let mut shadows: Vec<usize> = pairs.iter().map(|p| p.1).collect();
+    shadows.sort_unstable();
+    shadows.dedup();
+    let sentences: Vec<String> = shadows
+        .iter()
+        .map(|&j| {
+            let s = &ev[j].0;
+            let qs: Vec<String> = pairs
+                .iter()
+                .filter(|p| p.1 == j)
+                .map(|&(i, _, ch)| {
+                    let q = &ev[i].0;
+                    format!(
+                        "{} (held-out {} −{:.1} % against {}'s −{:.1} %)",
+                        q.name,
+                        ch.name(),
+                        gain_in(q, ch),
+                        s.name,
+                        gain_in(s, ch)
+                    )
+                })
+                .collect();
+            format!(
+                "{} {} but {} not named: {} removes more than {:.0}× as much of the same held-out error and is itself not named ({}), so what {} is part of a larger structure that no candidate models cleanly.",
+                qs.join(" and "),
+                if qs.len() == 1 { "qualifies" } else { "qualify" },
+                if qs.len() == 1 { "is" } else { "are" },
+                s.name,
+                OVERSHADOW,
+                why_not(s).unwrap_or_default(),
+                if qs.len() == 1 { "it removes" } else { "they remove" }
+            )
+        })
+        .collect();
+    (!sentences.is_empty()).then(|| sentences.join(" "))
 }
 
 /// The other qualifying candidates ([`qualifies`]) besides the verdict
@@ -67,7 +178,7 @@ pub fn select(ev: &[(Evaluation, Box<dyn Fitted>)]) -> Option<usize> {
 /// should hear of the other.
 pub fn also_qualifying(ev: &[(Evaluation, Box<dyn Fitted>)], winner: Option<usize>) -> Vec<usize> {
     let mut v: Vec<usize> = (0..ev.len())
-        .filter(|&i| Some(i) != winner && qualifies(&ev[i].0))
+        .filter(|&i| Some(i) != winner && qualifies(&ev[i].0) && overshadowed(ev, i).is_none())
         .collect();
     v.sort_by(|&a, &b| ev[a].0.delta_bic.total_cmp(&ev[b].0.delta_bic));
     v
@@ -168,6 +279,22 @@ mod tests {
         }
     }
 
+    /// `e` named `name`, paired with a fitted model (the `none`
+    /// candidate's: the selection reads only the evaluation).
+    fn with_fitted(mut e: Evaluation, name: &str) -> (Evaluation, Box<dyn Fitted>) {
+        e.name = name.into();
+        let none = super::super::NoneCandidate
+            .fit(
+                &crate::data::Recording::default(),
+                &crate::mf::Tyre::builtin(),
+                &crate::residual::ReplayOptions::default(),
+                &[],
+                &[1.0; 3],
+            )
+            .unwrap();
+        (e, none)
+    }
+
     /// The real-data case of the old rule: a large gain on the badly fitted
     /// Mz bought with a worse Fy does not name an effect, however the
     /// pooled number and the BIC look.
@@ -210,18 +337,7 @@ mod tests {
     fn the_other_qualifying_candidates_are_listed_by_bic() {
         let strong = |bic: f64| ev(&[(Channel::Fy, 0.10, -30.0)], 0.08, bic);
         let weak = ev(&[(Channel::Fy, 0.01, 3.0)], 0.01, 5.0);
-        let boxed = |e: Evaluation| -> (Evaluation, Box<dyn Fitted>) {
-            let none = super::super::NoneCandidate
-                .fit(
-                    &crate::data::Recording::default(),
-                    &crate::mf::Tyre::builtin(),
-                    &crate::residual::ReplayOptions::default(),
-                    &[],
-                    &[1.0; 3],
-                )
-                .unwrap();
-            (e, none)
-        };
+        let boxed = |e: Evaluation| with_fitted(e, "x");
         let list = vec![
             boxed(strong(-5.0)),
             boxed(weak),
@@ -232,6 +348,56 @@ mod tests {
         assert_eq!(winner, Some(2));
         assert_eq!(also_qualifying(&list, winner), vec![3, 0]);
         assert_eq!(also_qualifying(&list, None), vec![2, 3, 0]);
+    }
+
+    /// A qualifier whose evidence channel another candidate explains more
+    /// than OVERSHADOW times better — one disqualified for spoiling a
+    /// different channel — is not named, and the words say by what; below
+    /// the factor, or when the other one removes less pooled error, the
+    /// qualifier is named.
+    #[test]
+    fn an_overshadowed_qualifier_is_not_named() {
+        let boxed = with_fitted;
+        let small = || {
+            ev(
+                &[(Channel::Fx, 0.01, 17.0), (Channel::Mz, 0.037, -23.0)],
+                0.013,
+                -1.4,
+            )
+        };
+        let shadow = |mz: f64, pooled: f64| {
+            ev(
+                &[(Channel::Fx, -0.21, 55.0), (Channel::Mz, mz, -177.0)],
+                pooled,
+                -96.0,
+            )
+        };
+        let list = vec![boxed(shadow(0.254, 0.12), "big"), boxed(small(), "small")];
+        assert!(qualifies(&list[1].0) && !qualifies(&list[0].0));
+        assert_eq!(overshadowed(&list, 1), Some((0, Channel::Mz)));
+        assert_eq!(select(&list), None);
+        assert!(also_qualifying(&list, None).is_empty());
+        let words = overshadowed_in_words(&list, 1).unwrap();
+        assert!(
+            words.contains("small removes 3.7 %") && words.contains("big removes 25.4 %"),
+            "{words}"
+        );
+        assert!(words.contains("Fx 21.0 % worse"), "{words}");
+        let summary = overshadowed_summary(&list).unwrap();
+        assert!(
+            summary.starts_with("small (held-out Mz −3.7 % against big's −25.4 %) qualifies"),
+            "{summary}"
+        );
+        // Under OVERSHADOW times the gain, or less pooled gain: named.
+        let list = vec![boxed(shadow(0.07, 0.12), "big"), boxed(small(), "small")];
+        assert_eq!(select(&list), Some(1));
+        let list = vec![boxed(shadow(0.254, 0.01), "big"), boxed(small(), "small")];
+        assert_eq!(select(&list), Some(1));
+        assert_eq!(
+            overshadowed(&list, 0),
+            None,
+            "only a qualifier is overshadowed"
+        );
     }
 
     /// Below MIN_GAIN in every channel: noise, whatever the BICs say.

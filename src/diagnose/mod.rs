@@ -15,10 +15,13 @@
 
 pub mod baseline;
 pub mod candidate;
+mod explain;
 pub mod factor;
 pub mod html;
 pub mod locate;
+mod misfit;
 pub mod plots;
+mod quality;
 pub mod reestimate;
 /// The residual stage's replay, kept at its former path for callers
 /// ([`crate::residual`] is its home).

@@ -2,7 +2,9 @@
 //! replay the baseline, locate the residual structure per channel, evaluate
 //! the candidates, choose the verdict, explain it in words, score the fit
 //! before and after per channel and condition (in-sample and held out), and
-//! build `diagnosis.json`.
+//! build `diagnosis.json`. The figures are the `quality` module's, the
+//! words the `explain` module's and the judgement of the baseline against
+//! the noise floor the `misfit` module's (re-exported here).
 //!
 //! # Quality figures
 //! σ = √(Σ(sim − test)² / Σ test²) and NRMSE = RMS(sim − test) / range(test)
@@ -18,8 +20,8 @@
 //! The significant [`locate`] findings of each channel are put in words
 //! ("the FY residual changes with the sweep direction (rising − falling
 //! +41 N) and follows the force rate"), then the verdict's physics and its
-//! fitted parameters in words ([`Evaluation::physics`], [`Evaluation::describe`])
-//! and the share of the held-out error it removes. For `none` the text
+//! fitted parameters in words (`Evaluation::physics`, `Evaluation::describe`
+//! of [`crate::diagnose::candidate::Evaluation`]) and the share of the held-out error it removes. For `none` the text
 //! says whether the residual showed structure at all and what the best
 //! candidate achieved.
 //!
@@ -30,22 +32,26 @@
 use super::candidate::param::rerolled;
 use super::candidate::{
     all, also_qualifying, channels_in_words, evaluate, overshadowed_in_words, overshadowed_summary,
-    refit_on_all, select, why_not, Candidate, ChannelScore, Evaluation,
+    refit_on_all, select, why_not, Candidate, ChannelScore,
 };
 use super::locate::{frictional_energy, locate, Finding, LocateOptions, Residuals};
 use super::reestimate::{beneath_rolling_radius, reestimate, Refit};
 use super::slip_channel;
 use crate::data::Recording;
 use crate::error::Result;
-use crate::fit::metrics::{self, nrmse, sigma};
 use crate::mf::{Forces, Tyre};
-use crate::residual::{
-    channel_sse, noise_floor, nrmse_per_channel, offsets, replay, Channel, ReplayOptions,
-};
+use crate::residual::{nrmse_per_channel, replay, Channel, ReplayOptions};
 use serde::Serialize;
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::ops::Range;
+
+use super::explain::at_bound_note;
+pub use super::explain::{caution, explain, findings_in_words, WORSE};
+pub use super::misfit::{baseline_fit, misfit_note, BaselineFit, MISFIT_RATIO};
+pub use super::quality::{
+    channel_present, channel_series, quality, split, QualityReport, QualityRow,
+};
 
 /// Smallest held-out gain that names an effect (the rule: [`super::candidate::select`]).
 pub use super::candidate::MIN_GAIN;
@@ -54,25 +60,6 @@ pub use super::candidate::MIN_GAIN;
 /// samples where `mask` is true (`None`: all), keyed "FX", "FY", "MZ"
 /// (None where the channel has no data).
 pub type NrmseMap = BTreeMap<&'static str, Option<f64>>;
-
-/// (measured, simulated, driving slip) of one channel.
-pub fn channel_series(
-    rec: &Recording,
-    sim: &[Forces],
-    channel: Channel,
-) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
-    let s = &rec.samples;
-    (
-        s.iter().map(|s| channel.measured(s)).collect(),
-        sim.iter().map(|f| channel.of_forces(f)).collect(),
-        s.iter().map(|s| channel.driving_slip(s)).collect(),
-    )
-}
-
-/// Whether the recording carries `channel`.
-pub fn channel_present(rec: &Recording, channel: Channel) -> bool {
-    rec.has(channel.name())
-}
 
 /// Locate findings of one channel.
 pub fn locate_channel(
@@ -96,356 +83,11 @@ pub fn locate_channel(
     locate(&d, &LocateOptions::default())
 }
 
-/// The candidates' split ([`super::candidate::split`]) as sample ranges:
-/// (fit half, held-out half).
-pub fn split(rec: &Recording) -> (Vec<Range<usize>>, Vec<Range<usize>>) {
-    let (fit, test) = super::candidate::split(rec);
-    (ranges(&fit), ranges(&test))
-}
-
-/// The runs of `true` in `mask` as half-open ranges.
-fn ranges(mask: &[bool]) -> Vec<Range<usize>> {
-    let mut out = Vec::new();
-    let mut start = None;
-    for (i, &m) in mask.iter().chain(std::iter::once(&false)).enumerate() {
-        match (m, start) {
-            (true, None) => start = Some(i),
-            (false, Some(a)) => {
-                out.push(a..i);
-                start = None;
-            }
-            _ => {}
-        }
-    }
-    out
-}
-
-/// One row of the quality table.
-#[derive(Clone, Debug, serde::Serialize)]
-pub struct QualityRow {
-    pub channel: Channel,
-    /// "all", "Fz 4000 N, γ 0.0°, p 220 kPa" or "Vx 16.2 m/s".
-    pub condition: String,
-    pub n: usize,
-    pub sigma_before: f64,
-    pub sigma_after: f64,
-    pub nrmse_before: f64,
-    pub nrmse_after: f64,
-}
-
-/// `sim` plus its constant offset from the measurement, estimated as the
-/// mean of (measured − sim) over `fit` (the fit half only, so the held-out
-/// half stays unseen).
-fn with_offset(y: &[f64], sim: &[f64], fit: &[Range<usize>]) -> Vec<f64> {
-    let (mut s, mut n) = (0.0, 0.0);
-    for r in fit {
-        for i in r.clone() {
-            let d = y[i] - sim[i];
-            if d.is_finite() {
-                s += d;
-                n += 1.0;
-            }
-        }
-    }
-    let o = if n > 0.0 { s / n } else { 0.0 };
-    sim.iter().map(|v| v + o).collect()
-}
-
-/// Before/after σ and NRMSE per channel and condition over `ranges`. Each
-/// model's constant channel offset (a sensor zero, not physics — the
-/// scoring of the candidates treats it so too) is estimated on the fit
-/// half `fit` and removed first.
-pub fn quality(
-    rec: &Recording,
-    before: &[Forces],
-    after: &[Forces],
-    fit: &[Range<usize>],
-    ranges: &[Range<usize>],
-) -> Result<Vec<QualityRow>> {
-    let mut rows = Vec::new();
-    for ch in Channel::SCORED {
-        if !channel_present(rec, ch) {
-            continue;
-        }
-        let name = ch.name();
-        let (_, sb, _) = channel_series(rec, before, ch);
-        let (y, sa, _) = channel_series(rec, after, ch);
-        let (sb, sa) = (with_offset(&y, &sb, fit), with_offset(&y, &sa, fit));
-        let mb = metrics::evaluate(rec, name, &sb, Some(ranges))?;
-        let ma = metrics::evaluate(rec, name, &sa, Some(ranges))?;
-        for (b, a) in mb.iter().zip(&ma) {
-            rows.push(QualityRow {
-                channel: ch,
-                condition: b.condition.as_ref().map_or("all".into(), |c| {
-                    format!(
-                        "Fz {:.0} N, γ {:.1}°, p {:.0} kPa",
-                        c.fz,
-                        c.gamma.to_degrees(),
-                        c.p / 1e3
-                    )
-                }),
-                n: b.n,
-                sigma_before: b.sigma,
-                sigma_after: a.sigma,
-                nrmse_before: b.nrmse,
-                nrmse_after: a.nrmse,
-            });
-        }
-        // Per speed, when the programme has more than one.
-        let mut speeds: Vec<f64> = rec
-            .segments
-            .iter()
-            .map(|g| (g.vx * 10.0).round() / 10.0)
-            .filter(|v| v.is_finite())
-            .collect();
-        speeds.sort_by(f64::total_cmp);
-        speeds.dedup();
-        if speeds.len() > 1 {
-            for v in speeds {
-                let (mut yy, mut pb, mut pa) = (Vec::new(), Vec::new(), Vec::new());
-                for g in rec
-                    .segments
-                    .iter()
-                    .filter(|g| (g.vx * 10.0).round() / 10.0 == v)
-                {
-                    for r in ranges {
-                        for i in g.start.max(r.start)..g.end.min(r.end).min(y.len()) {
-                            yy.push(y[i]);
-                            pb.push(sb[i]);
-                            pa.push(sa[i]);
-                        }
-                    }
-                }
-                if !yy.is_empty() {
-                    rows.push(QualityRow {
-                        channel: ch,
-                        condition: format!("Vx {v:.1} m/s"),
-                        n: yy.iter().filter(|x| x.is_finite()).count(),
-                        sigma_before: sigma(&pb, &yy),
-                        sigma_after: sigma(&pa, &yy),
-                        nrmse_before: nrmse(&pb, &yy),
-                        nrmse_after: nrmse(&pa, &yy),
-                    });
-                }
-            }
-        }
-    }
-    Ok(rows)
-}
-
-/// The significant findings of one channel in words ("changes with the
-/// sweep direction (rising − falling +41 N) and follows the force rate"),
-/// or None when nothing is significant. At most the three strongest (by z;
-/// [`locate`] ranks them) are named.
-pub fn findings_in_words(findings: &[Finding], unit: &str) -> Option<String> {
-    let parts: Vec<String> = findings
-        .iter()
-        .filter(|f| f.significant)
-        .take(3)
-        .map(|f| {
-            let scale = |what: &str| {
-                format!(
-                    "scales with {what} (force scale error {:+.1} % at {}, {:+.1} % at {})",
-                    100.0 * f.group("scale_at_min"),
-                    set_point(f.name, f.group("x_min")),
-                    100.0 * f.group("scale_at_max"),
-                    set_point(f.name, f.group("x_max"))
-                )
-            };
-            match f.name {
-                "sweep_direction" => format!(
-                    "changes with the sweep direction (rising − falling {} {unit} at equal slip)",
-                    sig3(f.group("rising_minus_falling"), true)
-                ),
-                "force_rate" => "follows the force rate (it grows with the slip rate)".into(),
-                "time_in_run" => format!(
-                    "drifts with time in the run ({} {unit}/s, + = measured getting stronger)",
-                    sig3(f.group("slope_per_s"), true)
-                ),
-                "slip_region" => {
-                    let regions = ["linear", "peak", "sliding"];
-                    let (k, v) = regions
-                        .iter()
-                        .map(|r| (*r, f.group(r)))
-                        .filter(|x| x.1.is_finite())
-                        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
-                        .unwrap_or(("linear", 0.0));
-                    format!(
-                        "concentrates in the {k} slip region (measured {} than the model by {} {unit} on average)",
-                        if v >= 0.0 { "stronger" } else { "weaker" },
-                        sig3(v.abs(), false)
-                    )
-                }
-                "load" => scale("load"),
-                "inclination" => scale("inclination"),
-                "pressure" => scale("pressure"),
-                "speed" => scale("speed"),
-                "energy" => scale("the accumulated frictional energy"),
-                other => format!("depends on {other}"),
-            }
-        })
-        .collect();
-    match parts.len() {
-        0 => None,
-        1 => Some(parts[0].clone()),
-        n => Some(format!(
-            "{} and {}",
-            parts[..n - 1].join(", "),
-            parts[n - 1]
-        )),
-    }
-}
-
-/// `x` to 3 significant digits (with its sign when `signed`).
-fn sig3(x: f64, signed: bool) -> String {
-    let d = if x == 0.0 || !x.is_finite() {
-        0
-    } else {
-        (2 - x.abs().log10().floor() as i32).clamp(0, 6) as usize
-    };
-    if signed {
-        format!("{x:+.d$}")
-    } else {
-        format!("{x:.d$}")
-    }
-}
-
-/// A set point in engineering units.
-fn set_point(grouping: &str, x: f64) -> String {
-    match grouping {
-        "load" => format!("{x:.0} N"),
-        "inclination" => format!("{:.1}°", x.to_degrees()),
-        "pressure" => format!("{:.1} kPa", x / 1e3),
-        "speed" => format!("{x:.1} m/s"),
-        "energy" => format!("{:.0} kJ", x / 1e3),
-        _ => format!("{x:.4}"),
-    }
-}
-
-/// The explanation of the verdict (see the module docs).
-pub fn explain(
-    findings: &[(Channel, Vec<Finding>)],
-    verdict: Option<&Evaluation>,
-    best_other: Option<&Evaluation>,
-    alpha: f64,
-) -> String {
-    let mut where_ = Vec::new();
-    for (ch, f) in findings {
-        if let Some(w) = findings_in_words(f, ch.unit()) {
-            where_.push(format!("the {} residual {w}", ch.name()));
-        }
-    }
-    let located = if where_.is_empty() {
-        None
-    } else {
-        Some(where_.join("; "))
-    };
-    match verdict {
-        Some(e) => format!(
-            "{}. Missing from the model: {}. {} removes {:.0} % of the baseline's error on held-out segments (each channel's squared error: {}; BIC {:+.1}).{}",
-            capitalise(located.as_deref().unwrap_or(
-                "no single grouping of the residual is significant on its own"
-            )),
-            e.physics,
-            capitalise(&e.describe),
-            100.0 * e.oos_gain,
-            channels_in_words(e),
-            e.delta_bic,
-            at_bound_note(e)
-        ),
-        None => {
-            let best = best_other.map_or("no candidate was evaluated".to_string(), |b| {
-                format!(
-                    "the best candidate, {}, removes {:.1} % of the held-out error ({}; BIC {:+.1}) and is not named: {}",
-                    b.name,
-                    100.0 * b.oos_gain,
-                    channels_in_words(b),
-                    b.delta_bic,
-                    why_not(b).unwrap_or_default()
-                )
-            });
-            match located {
-                None => format!(
-                    "Nothing is missing: the residual is noise (no grouping significant at {:.0} % family-wise) and {best}.",
-                    100.0 * alpha
-                ),
-                Some(w) => format!(
-                    "{}, but none of the candidates explains it: {best}. The structure is real but lies outside the candidate physics (or in the baseline's own fit).",
-                    capitalise(&w)
-                ),
-            }
-        }
-    }
-}
-
-/// " PPY3 = -3 (its lower bound) is at a bound of its range: …", or "".
-fn at_bound_note(e: &Evaluation) -> String {
-    if e.at_bound.is_empty() {
-        return String::new();
-    }
-    format!(
-        " {} at a bound of the range the candidate allows: the data push beyond it, so that value is a limit, not an estimate.",
-        e.at_bound.join(", ")
-    )
-}
-
-/// Relative rise of a channel's held-out σ above which the verdict's
-/// explanation carries a caution (10 %: well above the run-to-run scatter
-/// of σ between the halves, far below what a real improvement shows).
-pub const WORSE: f64 = 0.10;
-
-/// A caution when the verdict's model makes a channel's held-out fit worse
-/// by more than [`WORSE`] (relative σ) while others gain: a tyre engineer
-/// would then suspect the gain comes from another misfit of the baseline
-/// that the extension happens to absorb, not from the named physics.
-pub fn caution(out_of_sample: &[QualityRow]) -> Option<String> {
-    let all: Vec<&QualityRow> = out_of_sample
-        .iter()
-        .filter(|r| r.condition == "all" && r.sigma_before.is_finite() && r.sigma_after.is_finite())
-        .collect();
-    let worse: Vec<String> = all
-        .iter()
-        .filter(|r| r.sigma_after > (1.0 + WORSE) * r.sigma_before)
-        .map(|r| {
-            format!(
-                "{} (held-out σ {:.2} % → {:.2} %)",
-                r.channel.name(),
-                100.0 * r.sigma_before,
-                100.0 * r.sigma_after
-            )
-        })
-        .collect();
-    if worse.is_empty() {
-        return None;
-    }
-    let better: Vec<&str> = all
-        .iter()
-        .filter(|r| r.sigma_after < r.sigma_before)
-        .map(|r| r.channel.name())
-        .collect();
-    Some(format!(
-        "Caution: it makes {} worse{}; the verdict is doubtful — the gain may be another misfit of the baseline that this extension absorbs.",
-        worse.join(" and "),
-        if better.is_empty() {
-            String::new()
-        } else {
-            format!(", the gain comes from {} alone", better.join(" and "))
-        }
-    ))
-}
-
-fn capitalise(s: &str) -> String {
-    let mut c = s.chars();
-    c.next().map_or(String::new(), |f| {
-        f.to_uppercase().collect::<String>() + c.as_str()
-    })
-}
-
 /// One candidate in `diagnosis.json` ("effects", the verdict first).
 #[derive(Clone, Debug, Serialize)]
 pub struct EffectReport {
     pub name: String,
-    /// Pooled held-out gain ([`Evaluation::oos_gain`]).
+    /// Pooled held-out gain ([`Evaluation::oos_gain`](crate::diagnose::candidate::Evaluation::oos_gain)).
     pub score: f64,
     pub delta_bic: f64,
     pub n_params: usize,
@@ -459,93 +101,6 @@ pub struct EffectReport {
     pub nrmse_after: NrmseMap,
     pub nrmse_before_held_out: NrmseMap,
     pub nrmse_after_held_out: NrmseMap,
-}
-
-/// The before/after quality tables of `diagnosis.json`.
-#[derive(Clone, Debug, Serialize)]
-pub struct QualityReport {
-    /// The model "after" is: the verdict's name.
-    pub model_after: String,
-    /// How the halves were formed, in words.
-    pub split: &'static str,
-    pub in_sample: Vec<QualityRow>,
-    pub out_of_sample: Vec<QualityRow>,
-}
-
-/// Ratio of the baseline's held-out residual RMS to the data's noise floor
-/// above which the baseline itself is judged to misfit: a model within the
-/// noise has a ratio near 1 (white sensor noise; filtered, coloured noise
-/// reads up to about 2 with the second-difference estimate); 3 leaves that
-/// margin and still flags a residual with most of its energy in structure.
-pub const MISFIT_RATIO: f64 = 3.0;
-
-/// The baseline against the noise floor the data show, per channel.
-#[derive(Clone, Debug, Serialize)]
-pub struct BaselineFit {
-    pub channel: Channel,
-    /// RMS of the baseline's held-out residual, offset removed (N, N m).
-    pub rms_residual: f64,
-    /// σ of the channel's high-frequency content ([`noise_floor`]).
-    pub noise_floor: f64,
-    /// rms_residual / noise_floor.
-    pub ratio: f64,
-}
-
-/// Per present channel: the baseline's held-out residual against the noise
-/// floor (offsets estimated on the fit half, as everywhere in the scoring).
-pub fn baseline_fit(
-    rec: &Recording,
-    base: &[Forces],
-    fit: &[bool],
-    test: &[bool],
-) -> Vec<BaselineFit> {
-    let o = offsets(rec, base, fit);
-    let sse = channel_sse(rec, base, test, &o);
-    Channel::SCORED
-        .iter()
-        .enumerate()
-        .filter(|(_, &ch)| channel_present(rec, ch))
-        .filter_map(|(k, &ch)| {
-            let (e, n) = sse[k];
-            if n == 0 {
-                return None;
-            }
-            let rms = (e / n as f64).sqrt();
-            let floor = noise_floor(rec, ch, test);
-            Some(BaselineFit {
-                channel: ch,
-                rms_residual: rms,
-                noise_floor: floor,
-                ratio: rms / floor,
-            })
-        })
-        .collect()
-}
-
-/// "Baseline misfit: …" when no effect is named and a channel's baseline
-/// residual stands above [`MISFIT_RATIO`] × its noise floor; None otherwise.
-pub fn misfit_note(fits: &[BaselineFit]) -> Option<String> {
-    let bad: Vec<String> = fits
-        .iter()
-        .filter(|f| f.ratio > MISFIT_RATIO)
-        .map(|f| {
-            format!(
-                "{} residual RMS {} {u} is {:.1}× the noise floor ({} {u})",
-                f.channel.name(),
-                sig3(f.rms_residual, false),
-                f.ratio,
-                sig3(f.noise_floor, false),
-                u = f.channel.unit()
-            )
-        })
-        .collect();
-    if bad.is_empty() {
-        return None;
-    }
-    Some(format!(
-        "Baseline misfit: the baseline's held-out {} — more than {MISFIT_RATIO:.0}× the sensor noise the data show, and no candidate physics removes it; the structure below is the baseline's own fit (or physics outside the candidates), so no effect is named.",
-        bad.join("; ")
-    ))
 }
 
 /// The re-estimation's outcome ([`crate::diagnose::reestimate`]).

@@ -1,0 +1,219 @@
+//! explain — a diagnosis in words: the located residual structure, the
+//! verdict's physics and fitted values, why the others are not named, and
+//! the cautions a tyre engineer should hear.
+//!
+//! Must never: call a grouping significant that [`super::locate`] did not,
+//! or state a figure the evaluation does not hold.
+
+use super::candidate::{channels_in_words, why_not, Evaluation};
+use super::locate::Finding;
+use super::quality::QualityRow;
+use crate::residual::Channel;
+
+/// The significant findings of one channel in words ("changes with the
+/// sweep direction (rising − falling +41 N) and follows the force rate"),
+/// or None when nothing is significant. At most the three strongest (by z;
+/// [`locate`](super::locate::locate) ranks them) are named.
+pub fn findings_in_words(findings: &[Finding], unit: &str) -> Option<String> {
+    let parts: Vec<String> = findings
+        .iter()
+        .filter(|f| f.significant)
+        .take(3)
+        .map(|f| {
+            let scale = |what: &str| {
+                format!(
+                    "scales with {what} (force scale error {:+.1} % at {}, {:+.1} % at {})",
+                    100.0 * f.group("scale_at_min"),
+                    set_point(f.name, f.group("x_min")),
+                    100.0 * f.group("scale_at_max"),
+                    set_point(f.name, f.group("x_max"))
+                )
+            };
+            match f.name {
+                "sweep_direction" => format!(
+                    "changes with the sweep direction (rising − falling {} {unit} at equal slip)",
+                    sig3(f.group("rising_minus_falling"), true)
+                ),
+                "force_rate" => "follows the force rate (it grows with the slip rate)".into(),
+                "time_in_run" => format!(
+                    "drifts with time in the run ({} {unit}/s, + = measured getting stronger)",
+                    sig3(f.group("slope_per_s"), true)
+                ),
+                "slip_region" => {
+                    let regions = ["linear", "peak", "sliding"];
+                    let (k, v) = regions
+                        .iter()
+                        .map(|r| (*r, f.group(r)))
+                        .filter(|x| x.1.is_finite())
+                        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+                        .unwrap_or(("linear", 0.0));
+                    format!(
+                        "concentrates in the {k} slip region (measured {} than the model by {} {unit} on average)",
+                        if v >= 0.0 { "stronger" } else { "weaker" },
+                        sig3(v.abs(), false)
+                    )
+                }
+                "load" => scale("load"),
+                "inclination" => scale("inclination"),
+                "pressure" => scale("pressure"),
+                "speed" => scale("speed"),
+                "energy" => scale("the accumulated frictional energy"),
+                other => format!("depends on {other}"),
+            }
+        })
+        .collect();
+    match parts.len() {
+        0 => None,
+        1 => Some(parts[0].clone()),
+        n => Some(format!(
+            "{} and {}",
+            parts[..n - 1].join(", "),
+            parts[n - 1]
+        )),
+    }
+}
+
+/// `x` to 3 significant digits (with its sign when `signed`).
+pub(crate) fn sig3(x: f64, signed: bool) -> String {
+    let d = if x == 0.0 || !x.is_finite() {
+        0
+    } else {
+        (2 - x.abs().log10().floor() as i32).clamp(0, 6) as usize
+    };
+    if signed {
+        format!("{x:+.d$}")
+    } else {
+        format!("{x:.d$}")
+    }
+}
+
+/// A set point in engineering units.
+fn set_point(grouping: &str, x: f64) -> String {
+    match grouping {
+        "load" => format!("{x:.0} N"),
+        "inclination" => format!("{:.1}°", x.to_degrees()),
+        "pressure" => format!("{:.1} kPa", x / 1e3),
+        "speed" => format!("{x:.1} m/s"),
+        "energy" => format!("{:.0} kJ", x / 1e3),
+        _ => format!("{x:.4}"),
+    }
+}
+
+/// The explanation of the verdict (see the module docs).
+pub fn explain(
+    findings: &[(Channel, Vec<Finding>)],
+    verdict: Option<&Evaluation>,
+    best_other: Option<&Evaluation>,
+    alpha: f64,
+) -> String {
+    let mut where_ = Vec::new();
+    for (ch, f) in findings {
+        if let Some(w) = findings_in_words(f, ch.unit()) {
+            where_.push(format!("the {} residual {w}", ch.name()));
+        }
+    }
+    let located = if where_.is_empty() {
+        None
+    } else {
+        Some(where_.join("; "))
+    };
+    match verdict {
+        Some(e) => format!(
+            "{}. Missing from the model: {}. {} removes {:.0} % of the baseline's error on held-out segments (each channel's squared error: {}; BIC {:+.1}).{}",
+            capitalise(located.as_deref().unwrap_or(
+                "no single grouping of the residual is significant on its own"
+            )),
+            e.physics,
+            capitalise(&e.describe),
+            100.0 * e.oos_gain,
+            channels_in_words(e),
+            e.delta_bic,
+            at_bound_note(e)
+        ),
+        None => {
+            let best = best_other.map_or("no candidate was evaluated".to_string(), |b| {
+                format!(
+                    "the best candidate, {}, removes {:.1} % of the held-out error ({}; BIC {:+.1}) and is not named: {}",
+                    b.name,
+                    100.0 * b.oos_gain,
+                    channels_in_words(b),
+                    b.delta_bic,
+                    why_not(b).unwrap_or_default()
+                )
+            });
+            match located {
+                None => format!(
+                    "Nothing is missing: the residual is noise (no grouping significant at {:.0} % family-wise) and {best}.",
+                    100.0 * alpha
+                ),
+                Some(w) => format!(
+                    "{}, but none of the candidates explains it: {best}. The structure is real but lies outside the candidate physics (or in the baseline's own fit).",
+                    capitalise(&w)
+                ),
+            }
+        }
+    }
+}
+
+/// " PPY3 = -3 (its lower bound) is at a bound of its range: …", or "".
+pub(crate) fn at_bound_note(e: &Evaluation) -> String {
+    if e.at_bound.is_empty() {
+        return String::new();
+    }
+    format!(
+        " {} at a bound of the range the candidate allows: the data push beyond it, so that value is a limit, not an estimate.",
+        e.at_bound.join(", ")
+    )
+}
+
+/// Relative rise of a channel's held-out σ above which the verdict's
+/// explanation carries a caution (10 %: well above the run-to-run scatter
+/// of σ between the halves, far below what a real improvement shows).
+pub const WORSE: f64 = 0.10;
+
+/// A caution when the verdict's model makes a channel's held-out fit worse
+/// by more than [`WORSE`] (relative σ) while others gain: a tyre engineer
+/// would then suspect the gain comes from another misfit of the baseline
+/// that the extension happens to absorb, not from the named physics.
+pub fn caution(out_of_sample: &[QualityRow]) -> Option<String> {
+    let all: Vec<&QualityRow> = out_of_sample
+        .iter()
+        .filter(|r| r.condition == "all" && r.sigma_before.is_finite() && r.sigma_after.is_finite())
+        .collect();
+    let worse: Vec<String> = all
+        .iter()
+        .filter(|r| r.sigma_after > (1.0 + WORSE) * r.sigma_before)
+        .map(|r| {
+            format!(
+                "{} (held-out σ {:.2} % → {:.2} %)",
+                r.channel.name(),
+                100.0 * r.sigma_before,
+                100.0 * r.sigma_after
+            )
+        })
+        .collect();
+    if worse.is_empty() {
+        return None;
+    }
+    let better: Vec<&str> = all
+        .iter()
+        .filter(|r| r.sigma_after < r.sigma_before)
+        .map(|r| r.channel.name())
+        .collect();
+    Some(format!(
+        "Caution: it makes {} worse{}; the verdict is doubtful — the gain may be another misfit of the baseline that this extension absorbs.",
+        worse.join(" and "),
+        if better.is_empty() {
+            String::new()
+        } else {
+            format!(", the gain comes from {} alone", better.join(" and "))
+        }
+    ))
+}
+
+pub(crate) fn capitalise(s: &str) -> String {
+    let mut c = s.chars();
+    c.next().map_or(String::new(), |f| {
+        f.to_uppercase().collect::<String>() + c.as_str()
+    })
+}

@@ -167,6 +167,67 @@ fn no_tir_on_rig_recording() {
     cleanup(&dir);
 }
 
+/// A recording without the slip ratio channel cannot show a rolling radius
+/// that is not the tyre's (the radius check reads the recorded SR): when
+/// nothing is named, the explanation says that check could not run. The
+/// dev set's control r06 with SR, SL and RE left out (skipped without
+/// ../shared); with them, the sentence is absent.
+#[test]
+fn a_recording_without_sr_says_the_radius_was_not_checked() {
+    use std::io::{BufRead, Write};
+    let gz = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/diagnose-dev/r06.dat.gz");
+    if !gz.is_file() {
+        eprintln!("skipped: {} absent", gz.display());
+        return;
+    }
+    let dir = tmp("nosr");
+    let lines: Vec<String> = std::io::BufReader::new(flate2::read::GzDecoder::new(
+        std::fs::File::open(&gz).unwrap(),
+    ))
+    .lines()
+    .map(|l| l.unwrap())
+    .collect();
+    let names: Vec<&str> = lines[0].split('\t').collect();
+    let keep: Vec<usize> = (0..names.len())
+        .filter(|&i| !["SR", "SL", "RE"].contains(&names[i]))
+        .collect();
+    assert_eq!(keep.len() + 3, names.len(), "r06 has SR, SL and RE");
+    let rec = dir.join("r06_nosr.dat");
+    let mut out = std::io::BufWriter::new(std::fs::File::create(&rec).unwrap());
+    for l in &lines {
+        let f: Vec<&str> = l.split('\t').collect();
+        writeln!(
+            out,
+            "{}",
+            keep.iter().map(|&i| f[i]).collect::<Vec<_>>().join("\t")
+        )
+        .unwrap();
+    }
+    drop(out);
+    let says = |rec: &Path, tag: &str| {
+        let rep = dir.join(tag);
+        let o = run_diagnose(&[rec.to_str().unwrap(), "--report", rep.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let j: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(rep.join("diagnosis.json")).unwrap())
+                .unwrap();
+        assert_eq!(j["verdict"], "none", "{tag}: {}", j["explanation"]);
+        j["explanation"]
+            .as_str()
+            .unwrap()
+            .contains("no slip ratio channel (SR)")
+    };
+    assert!(
+        says(&rec, "without"),
+        "the missing radius check is not mentioned"
+    );
+    assert!(
+        !says(&gz, "with"),
+        "the sentence appears though SR is recorded"
+    );
+    cleanup(&dir);
+}
+
 /// The real flat-belt lateral test (MFeval's fitting example): runs end to
 /// end without --tir and writes every output; Fx (crosstalk in a pure
 /// lateral test, no stage fits it) is not diagnosed. Skipped without ../shared.

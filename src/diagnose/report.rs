@@ -429,6 +429,14 @@ pub fn diagnose_with(
             format!("{explanation} Also: {w}")
         };
     }
+    // What could not be checked: a radius that is not the tyre's hides in the
+    // baseline's horizontal shift of Fx, and only the recorded slip ratio
+    // shows it (`slip_channel`).
+    if verdict_i.is_none() && slip.is_none() && rec.has("omega") && rec.extra("SR").is_none() {
+        explanation.push_str(
+            " The recording has no slip ratio channel (SR), so the rolling-radius check (the slip the rig recorded at free rolling against the wheel's own V/Ω) could not run: a rolling radius that is not the tyre's would stay hidden in the baseline's horizontal shift of Fx.",
+        );
+    }
     // Empty without a verdict: `select` names one whenever any qualifies.
     let also = also_qualifying(&ev, verdict_i);
     if !also.is_empty() {

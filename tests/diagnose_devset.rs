@@ -479,6 +479,23 @@ fn devset_verdicts_hold_with_other_sensor_noise_and_offsets() {
     no_wrong_name(&v, "with other sensors", NAMED_BEFORE);
 }
 
+/// The limit of the sensor variation: twice its zero errors (FX +25 N,
+/// FY −40 N, MZ +1.5 N m, FZ +15 N), no added noise. Measured 29 Nov 2026
+/// (this test, 316 s): r03 (load sensitivity) named `camber` and control
+/// r08 `load_sensitivity`, the other 19 as on the recordings — the
+/// baseline's Magic Formula has no sensor-zero term (README, "Diagnosis",
+/// variation 5). Ignored until the baseline fit profiles out a per-channel
+/// zero; a spike of that gave all 21 verdicts as on the recordings.
+#[test]
+#[ignore = "twice the sensor variation's zero errors gives two wrong names (r03, r08): the baseline has no sensor-zero term yet (README, Diagnosis, variation 5)"]
+fn devset_verdicts_hold_with_twice_the_zero_errors() {
+    let Some(v) = variant_verdicts("diagnose_devset_zeros", |n, l| sensors(n, l, 2.0, false))
+    else {
+        return;
+    };
+    no_wrong_name(&v, "with twice the zero errors", NAMED_BEFORE);
+}
+
 /// Prints a variation's verdicts and asserts that none is wrong (each is
 /// the answer's effect or `none`, so every control stays `none`) and, over
 /// all 21, that at least `named_before` effects are named.
@@ -497,13 +514,25 @@ fn no_wrong_name(v: &[(String, String, String)], what: &str, named_before: usize
     }
 }
 
+/// The zero errors of a sensor variation (ISO names as the recording's
+/// columns, SAE signs as recorded): FX, FY (N), MZ (N m), FZ (N).
+const ZEROS: [(&str, f64); 4] = [("FX", 12.5), ("FY", -20.0), ("MZ", 0.75), ("FZ", 7.5)];
+
 /// The rewrite of [`devset_verdicts_hold_with_other_sensor_noise_and_offsets`].
-fn other_sensors(name: &str, mut lines: Vec<String>) -> Vec<String> {
+fn other_sensors(name: &str, lines: Vec<String>) -> Vec<String> {
+    sensors(name, lines, 1.0, true)
+}
+
+/// The lines with `scale` × [`ZEROS`] added to the force and load channels
+/// and, with `noise`, the channels' own noise doubled in variance (seeded
+/// per recording).
+fn sensors(name: &str, mut lines: Vec<String>, scale: f64, noise: bool) -> Vec<String> {
     use rand::{Rng, SeedableRng};
     let names: Vec<String> = lines[0].split('\t').map(str::to_string).collect();
     let seed = name.bytes().fold(20261129u64, |h, b| h * 31 + b as u64);
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-    for (ch, offset) in [("FX", 12.5), ("FY", -20.0), ("MZ", 0.75), ("FZ", 7.5)] {
+    for (ch, zero) in ZEROS {
+        let offset = scale * zero;
         let j = names.iter().position(|n| n == ch).expect("channel");
         let x: Vec<f64> = lines[2..]
             .iter()
@@ -522,8 +551,12 @@ fn other_sensors(name: &str, mut lines: Vec<String>) -> Vec<String> {
         let sigma = d[d.len() / 2] / 0.6745 / 2f64.sqrt();
         for (l, v) in lines[2..].iter_mut().zip(&x) {
             // Box–Muller: one standard normal from two uniforms.
-            let (u1, u2): (f64, f64) = (rng.gen_range(f64::EPSILON..1.0), rng.gen());
-            let z = (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos();
+            let z = if noise {
+                let (u1, u2): (f64, f64) = (rng.gen_range(f64::EPSILON..1.0), rng.gen());
+                (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+            } else {
+                0.0
+            };
             let mut cells: Vec<String> = l.split('\t').map(str::to_string).collect();
             cells[j] = format!("{:.3}", v + offset + sigma * z);
             *l = cells.join("\t");

@@ -389,14 +389,10 @@ fn variant_verdicts(
     test: &str,
     rewrite: fn(&str, Vec<String>) -> Vec<String>,
 ) -> Option<Vec<(String, String, String)>> {
-    use std::io::{BufRead, Write};
+    use std::io::Write;
     devset::run_all(test, |a, work, data| {
         let path = work.join(format!("{}.dat", a.name));
-        let f = std::fs::File::open(&a.file).expect("recording");
-        let lines: Vec<String> = std::io::BufReader::new(flate2::read::GzDecoder::new(f))
-            .lines()
-            .map(|l| l.expect("text"))
-            .collect();
+        let lines = devset::read_lines(&a.file);
         let mut out = std::io::BufWriter::new(std::fs::File::create(&path).expect("variant"));
         for l in rewrite(&a.name, lines) {
             writeln!(out, "{l}").expect("write");

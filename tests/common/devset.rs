@@ -83,14 +83,20 @@ pub struct Raw {
     pub mz: Vec<f64>,
 }
 
-/// Read a gzip'd TTC text recording (row 1 names, row 2 units).
-pub fn read_raw(path: &Path) -> Raw {
+/// The lines of a gzip'd TTC text recording (names, units, data rows).
+pub fn read_lines(path: &Path) -> Vec<String> {
     let f = std::fs::File::open(path).expect("recording");
     let mut text = String::new();
     flate2::read::GzDecoder::new(f)
         .read_to_string(&mut text)
         .expect("gzip text");
-    let mut lines = text.lines();
+    text.lines().map(str::to_string).collect()
+}
+
+/// Read a gzip'd TTC text recording (row 1 names, row 2 units).
+pub fn read_raw(path: &Path) -> Raw {
+    let text = read_lines(path);
+    let mut lines = text.iter();
     let names: Vec<&str> = lines.next().expect("header").split_whitespace().collect();
     let col = |n: &str| names.iter().position(|x| *x == n).expect(n);
     let (et, sa, sr, fz, fx, fy, mz) = (

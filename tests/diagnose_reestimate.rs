@@ -66,7 +66,7 @@ fn fitted_and_diagnosed(rec: Recording) -> (Recording, Tyre, Diagnosis, Diagnosi
     let fitted_on = recs[0].clone();
     drop_unfitted(&mut recs, &b);
     let rec = recs.pop().unwrap();
-    let base = Tyre::new(b.tyre).unwrap();
+    let base = Tyre::new(b.compared().clone()).unwrap();
     let opts = ReplayOptions::default();
     let plain = diagnose_with(&rec, &base, &opts, None, &mut |_| {}).unwrap();
     let refit = refit_fitted_baseline(2);

@@ -86,7 +86,7 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
         "[diagnose] baseline fit (every {}. sample) {t_fit:8.3} s",
         b.stride
     );
-    let fitted = Tyre::new(b.tyre)?;
+    let fitted = Tyre::new(b.compared().clone())?;
     let rec = &recs[0];
     let t0 = Instant::now();
     let refit = refit_fitted_baseline(threads);

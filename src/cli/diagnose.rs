@@ -13,6 +13,7 @@ use crate::data::ReChoice;
 use crate::diagnose::baseline::{drop_unfitted, fit_baseline, HELD_PRESSURE_KEYS};
 use crate::diagnose::reestimate::{refit_fitted_baseline, Refit};
 use crate::diagnose::report::{diagnose_with, merge};
+use crate::diagnose::sensor_zero::{as_measured, ZeroFinding};
 use crate::diagnose::{html, plots};
 use crate::fit::Progress;
 use crate::mf::Tyre;
@@ -90,6 +91,10 @@ pub fn run(a: Args) -> Result<()> {
     std::fs::create_dir_all(&a.report).map_err(|e| Error::io(&a.report, e))?;
     // The recording as the baseline was fitted on, before drop_unfitted.
     let mut fitted_on = None;
+    // The sensor zeros found, and the baseline fitted to the recording as
+    // measured when the comparison removed them (the files are built on it).
+    let mut sensor_zeros = None;
+    let mut measured = None;
     let (tyre, note) = match (&a.tir, given) {
         (Some(tir), Some(t)) => (
             t,
@@ -143,7 +148,33 @@ pub fn run(a: Args) -> Result<()> {
                     if dropped.len() == 1 { "it" } else { "them" }
                 ));
             }
-            (Tyre::new(fit.tyre)?, note)
+            match (fit.zeroed.is_some(), fit.zero_fit_gain) {
+                (true, Some(g)) => note.push_str(&format!(
+                    " Sensor zeros in the baseline's residual (its intercept over load, which the MF's load-proportional shifts cannot take up): {}; without them the MF fits {:.1} % better, so the diagnosis compares with the MF fitted with them removed, while baseline.tir and extended.tir are fitted to the recording as measured (the FMU has no sensor).",
+                    fit.zeros.in_words(),
+                    100.0 * g
+                )),
+                (false, Some(g)) => note.push_str(&format!(
+                    " Sensor zeros in the baseline's residual: {}; left to the MF's shifts (without them it fits only {:.1} % better, under the {:.0} % that would change the comparison).",
+                    fit.zeros.in_words(),
+                    100.0 * g,
+                    100.0 * crate::diagnose::sensor_zero::MIN_FIT_GAIN
+                )),
+                _ => {}
+            }
+            if !fit.zeros.not_estimated.is_empty() {
+                note.push_str(&format!(
+                    " No sensor zero estimated for {}.",
+                    fit.zeros.not_estimated.join("; ")
+                ));
+            }
+            sensor_zeros = Some(ZeroFinding {
+                zeros: fit.zeros.clone(),
+                fit_gain: fit.zero_fit_gain,
+                removed: fit.zeroed.is_some(),
+            });
+            measured = fit.zeroed.is_some().then(|| fit.tyre.clone());
+            (Tyre::new(fit.compared().clone())?, note)
         }
     };
     let m = &a.manners;
@@ -175,10 +206,15 @@ pub fn run(a: Args) -> Result<()> {
         }),
         &mut step,
     )?;
-    let mut base = tyre.params().clone();
+    let (mut base, mut ext) = match &measured {
+        Some(measured) => (
+            measured.clone(),
+            as_measured(d.extended.params(), tyre.params(), measured),
+        ),
+        None => (tyre.params().clone(), d.extended.params().clone()),
+    };
     prov.stamp(&mut base);
     base.write(&a.report.join("baseline.tir"))?;
-    let mut ext = d.extended.params().clone();
     prov.lines.push(format!("diagnosis verdict: {}", d.verdict));
     prov.stamp(&mut ext);
     ext.write(&a.report.join("extended.tir"))?;
@@ -188,6 +224,7 @@ pub fn run(a: Args) -> Result<()> {
     }
     let mut report = d.report.clone();
     report.baseline = Some(note.clone());
+    report.sensor_zeros = sensor_zeros;
     report.plots = serde_json::to_value(&pl).ok();
     let jp = a.report.join("diagnosis.json");
     let text = serde_json::to_string_pretty(&report)

@@ -2,7 +2,8 @@
 //! the residual stage ([`crate::residual`]: replay, channels, scores), locate
 //! where the residuals concentrate with a statistic and a significance for
 //! each grouping ([`locate`]), fit the baseline when none is given
-//! ([`baseline`]), name, model and fit the physics left out ([`candidate`];
+//! ([`baseline`]) without the sensor zeros its residual shows
+//! ([`sensor_zero`]), name, model and fit the physics left out ([`candidate`];
 //! a rolling radius the forces cannot show, from the recorded slip ratio
 //! against the free-rolling radius: [`slip_channel`]), fit a fitted
 //! baseline again beneath the named extension for the file ([`reestimate`]),
@@ -31,4 +32,5 @@ pub mod replay {
     };
 }
 pub mod report;
+pub mod sensor_zero;
 pub mod slip_channel;

@@ -150,6 +150,11 @@ pub struct DiagnosisReport {
     /// How the baseline was obtained (set by the command).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub baseline: Option<String>,
+    /// The sensor zeros removed before the comparison (set by the command;
+    /// [`super::sensor_zero`]); absent with `--tir` or when none could be
+    /// estimated.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sensor_zeros: Option<super::sensor_zero::ZeroFinding>,
     /// The plots drawn (set by the command).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub plots: Option<Value>,
@@ -501,6 +506,7 @@ pub fn diagnose_with(
         samples: rec.samples.len(),
         segments: rec.segments.len(),
         baseline: None,
+        sensor_zeros: None,
         plots: None,
     };
     Ok(Diagnosis {

@@ -50,6 +50,14 @@ pub struct MfFitOptions {
     /// My equations). Off by default (the diagnosis baseline holds Re terms
     /// for its rolling-radius candidate); `tyrekit fit` turns it on.
     pub geometry: bool,
+    /// Recordings the geometry step reads instead of the fitted ones (the
+    /// same samples with other force values). The diagnosis fits its
+    /// baseline again without the sensor zeros
+    /// ([`crate::diagnose::sensor_zero`]) and keeps the geometry of the
+    /// recording as measured: the free-rolling selection reads Fx, so a
+    /// shifted Fx would pick other samples and another Re(Fz). `None`: the
+    /// fitted ones.
+    pub geometry_recordings: Option<std::sync::Arc<Vec<Recording>>>,
     pub threads: usize,
     pub fit: FitOptions,
     /// Minimum samples for a stage to run.
@@ -72,6 +80,7 @@ impl Default for MfFitOptions {
             nominal_from_data: true,
             generic_start: true,
             geometry: false,
+            geometry_recordings: None,
             threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
             fit: FitOptions {
                 coarse_first: true,
@@ -518,7 +527,11 @@ pub fn fit_mf(
     widen_ranges(&mut tyre, recs)?;
     let geometry = if opts.geometry {
         let _t = super::timing::span(|| "geometry".into());
-        Some(super::geometry::fit_geometry(&mut tyre, recs)?)
+        let on = opts
+            .geometry_recordings
+            .as_deref()
+            .map_or(recs, |v| v.as_slice());
+        Some(super::geometry::fit_geometry(&mut tyre, on)?)
     } else {
         None
     };

@@ -86,7 +86,8 @@ pub struct Baseline {
 
 impl Baseline {
     /// The tyre the diagnosis compares the recordings with: the fit without
-    /// the sensor zeros where they were estimated, else [`Baseline::tyre`].
+    /// the sensor zeros where removing them gained the fit at least
+    /// [`sensor_zero::MIN_FIT_GAIN`], else [`Baseline::tyre`].
     pub fn compared(&self) -> &TyreParams {
         self.zeroed.as_ref().unwrap_or(&self.tyre)
     }
@@ -229,8 +230,9 @@ pub fn fit_baseline(
         threads,
         progress.as_deref_mut(),
     )?;
-    let thinned: Vec<Recording> = recs.iter().map(|r| decimate(r, b.stride)).collect();
-    let zeros = sensor_zero::estimate(&thinned, &b.tyre, &b.fitted())?;
+    // The residual the fit minimised: on the data as it saw them.
+    let seen = fit_data(recs, b.stride, true);
+    let zeros = sensor_zero::estimate(&seen, &b.tyre, &b.fitted())?;
     if zeros.any() {
         let corrected: Vec<Recording> = recs
             .iter()

@@ -17,6 +17,7 @@ use crate::diagnose::baseline::{drop_unfitted, fit_baseline};
 use crate::diagnose::locate::frictional_energy;
 use crate::diagnose::reestimate::{refit_fitted_baseline, Refit};
 use crate::diagnose::report::{diagnose_with, locate_channel};
+use crate::diagnose::sensor_zero::{extended_as_measured, for_diagnosis};
 use crate::diagnose::{html, plots};
 use crate::mf::Tyre;
 use crate::residual::{replay, Channel, ReplayOptions};
@@ -83,23 +84,35 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
     drop_unfitted(&mut recs, &b);
     let t_fit = t0.elapsed().as_secs_f64();
     println!(
-        "[diagnose] baseline fit (every {}. sample) {t_fit:8.3} s",
-        b.stride
+        "[diagnose] baseline fit (every {}. sample) {t_fit:8.3} s; sensor zeros {} ({})",
+        b.stride,
+        b.zeros.in_words(),
+        if b.zeroed.is_some() {
+            "removed: the diagnosis compares without them, extended.tir built again as measured"
+        } else {
+            "left to the MF's shifts"
+        }
     );
     let fitted = Tyre::new(b.compared().clone())?;
-    let rec = &recs[0];
     let t0 = Instant::now();
+    let for_d = for_diagnosis(Some(&b), recs.remove(0), Some(fitted_on));
+    let rec = &for_d.rec;
     let refit = refit_fitted_baseline(threads);
     let d = diagnose_with(
         rec,
         &fitted,
         &ReplayOptions::default(),
-        Some(Refit {
+        for_d.fitted_on.as_ref().map(|r| Refit {
             fit: &refit,
-            fitted_on: &fitted_on,
+            fitted_on: r,
         }),
         &mut |_| {},
     )?;
+    // extended.tir as the command writes it where the zeros were removed.
+    if let Some(m) = &for_d.measured {
+        let mut report = d.report.clone();
+        extended_as_measured(&d, &fitted, m, &refit, &mut |_| {}, &mut report)?;
+    }
     let t_diag = t0.elapsed().as_secs_f64();
     let t0 = Instant::now();
     let pl = plots::draw_all(rec, &d, &dir)?;

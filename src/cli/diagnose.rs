@@ -13,7 +13,9 @@ use crate::data::ReChoice;
 use crate::diagnose::baseline::{drop_unfitted, fit_baseline, HELD_PRESSURE_KEYS};
 use crate::diagnose::reestimate::{refit_fitted_baseline, Refit};
 use crate::diagnose::report::{diagnose_with, merge};
-use crate::diagnose::sensor_zero::{as_measured, ZeroFinding};
+use crate::diagnose::sensor_zero::{
+    extended_as_measured, for_diagnosis, ForDiagnosis, ZeroFinding,
+};
 use crate::diagnose::{html, plots};
 use crate::fit::Progress;
 use crate::mf::Tyre;
@@ -91,10 +93,10 @@ pub fn run(a: Args) -> Result<()> {
     std::fs::create_dir_all(&a.report).map_err(|e| Error::io(&a.report, e))?;
     // The recording as the baseline was fitted on, before drop_unfitted.
     let mut fitted_on = None;
-    // The sensor zeros found, and the baseline fitted to the recording as
-    // measured when the comparison removed them (the files are built on it).
+    // The sensor zeros found, and the baseline fit (its zeros decide what
+    // the diagnosis compares: sensor_zero::for_diagnosis).
     let mut sensor_zeros = None;
-    let mut measured = None;
+    let mut fitted = None;
     let (tyre, note) = match (&a.tir, given) {
         (Some(tir), Some(t)) => (
             t,
@@ -150,7 +152,7 @@ pub fn run(a: Args) -> Result<()> {
             }
             match (fit.zeroed.is_some(), fit.zero_fit_gain) {
                 (true, Some(g)) => note.push_str(&format!(
-                    " Sensor zeros in the baseline's residual (its intercept over load, which the MF's load-proportional shifts cannot take up): {}; without them the MF fits {:.1} % better, so the diagnosis compares with the MF fitted with them removed, while baseline.tir and extended.tir are fitted to the recording as measured (the FMU has no sensor).",
+                    " Sensor zeros in the baseline's residual (its intercept over load, which the MF's load-proportional shifts cannot take up): {}; without them the MF fits {:.1} % better, so the diagnosis compares the recording with them subtracted with the MF fitted without them (the plots and held-out figures are of that copy), while baseline.tir and extended.tir — the verdict fitted again beneath the first fit — are fitted to the recording as measured (the FMU has no sensor).",
                     fit.zeros.in_words(),
                     100.0 * g
                 )),
@@ -173,13 +175,20 @@ pub fn run(a: Args) -> Result<()> {
                 fit_gain: fit.zero_fit_gain,
                 removed: fit.zeroed.is_some(),
             });
-            measured = fit.zeroed.is_some().then(|| fit.tyre.clone());
-            (Tyre::new(fit.compared().clone())?, note)
+            let compared = Tyre::new(fit.compared().clone())?;
+            fitted = Some(fit);
+            (compared, note)
         }
     };
     let m = &a.manners;
     m.say(&note);
-    let rec = merge(recs);
+    // Where the zeros were removed, the diagnosis compares the recording
+    // without them with the MF fitted without them.
+    let ForDiagnosis {
+        rec,
+        fitted_on,
+        measured,
+    } = for_diagnosis(fitted.as_ref(), merge(recs), fitted_on);
     let steps = bar(m, 4, "{prefix:>12} [{bar:30}] {pos}/{len} {msg} {elapsed}");
     if let Some(b) = &steps {
         b.set_prefix("diagnose");
@@ -206,11 +215,12 @@ pub fn run(a: Args) -> Result<()> {
         }),
         &mut step,
     )?;
+    let mut report = d.report.clone();
     let (mut base, mut ext) = match &measured {
-        Some(measured) => (
-            measured.clone(),
-            as_measured(d.extended.params(), tyre.params(), measured),
-        ),
+        Some(m) => {
+            let ext = extended_as_measured(&d, &tyre, m, &refit, &mut step, &mut report)?;
+            (m.tyre.clone(), ext)
+        }
         None => (tyre.params().clone(), d.extended.params().clone()),
     };
     prov.stamp(&mut base);
@@ -222,7 +232,6 @@ pub fn run(a: Args) -> Result<()> {
     if let Some(b) = &steps {
         b.finish_and_clear();
     }
-    let mut report = d.report.clone();
     report.baseline = Some(note.clone());
     report.sensor_zeros = sensor_zeros;
     report.plots = serde_json::to_value(&pl).ok();

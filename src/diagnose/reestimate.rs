@@ -44,6 +44,12 @@
 //! the diagnosis fitted its baseline itself: a baseline given with `--tir`
 //! is the user's tyre and stays.
 //!
+//! [`build_extended`] is the one recipe of the file: the chosen verdict
+//! refitted on every segment, then the rounds above (or the rolling-radius
+//! refit), for the diagnosis and for the file built again on the recording
+//! as measured when the comparison removed sensor zeros
+//! ([`super::sensor_zero::extended_as_measured`]).
+//!
 //! Must never: change the verdict, the held-out scores or `baseline.tir`
 //! (they are the baseline's, fitted without any extension), or return a
 //! file whose in-sample error is higher than the plain refit's.
@@ -337,6 +343,98 @@ pub fn beneath_rolling_radius(
         out.failed = Some(e.to_string());
     }
     out
+}
+
+/// What `extended.tir` is built on once the verdict is chosen.
+#[derive(Clone, Copy)]
+pub enum FileOf<'a> {
+    /// A force candidate, refitted on every segment ([`refit_on_all`]).
+    Candidate(&'a dyn Candidate),
+    /// A rolling-radius finding of the slip channel: the baseline with the
+    /// tyre's own Re(Fz) ([`super::slip_channel::SlipChannel::extended`]).
+    Radius(&'a Tyre),
+}
+
+/// The extended tyre of [`build_extended`].
+pub struct BuiltExtension {
+    /// A candidate verdict: the extension refitted on every segment (on the
+    /// re-estimated baseline where that lowered the error); `None` when the
+    /// refit failed ([`Self::refit_failed`]).
+    pub fitted: Option<Box<dyn Fitted>>,
+    /// A slip-channel radius finding with the MF fitted again beneath it
+    /// (`None` without a [`Refit`]: the finding's tyre itself is the file).
+    pub radius: Option<Tyre>,
+    /// The re-estimation's (rounds, plain cost, cost, error that stopped it).
+    pub reestimated: Option<(usize, f64, f64, Option<String>)>,
+    /// Why the candidate's refit on every segment failed.
+    pub refit_failed: Option<String>,
+}
+
+impl BuiltExtension {
+    /// The tyre for `extended.tir` (`None` when the candidate's refit failed).
+    pub fn tyre(&self) -> Option<&Tyre> {
+        self.fitted
+            .as_ref()
+            .map(|f| f.tyre())
+            .or(self.radius.as_ref())
+    }
+}
+
+/// `extended.tir`'s tyre for a chosen verdict `of` on `rec` against the
+/// baseline `tyre`: the extension refitted on every segment
+/// ([`refit_on_all`]), and — when the diagnosis fitted the baseline itself
+/// (`refit`) — the baseline's MF fitted again beneath it
+/// (this module). One recipe for the diagnosis and for
+/// a file built on another baseline (the command's sensor zeros:
+/// [`super::sensor_zero`]). `step` hears "re-estimate baseline" before that
+/// part runs.
+pub fn build_extended(
+    rec: &Recording,
+    tyre: &Tyre,
+    opts: &ReplayOptions,
+    of: FileOf,
+    refit: Option<Refit>,
+    step: &mut dyn FnMut(&str),
+) -> BuiltExtension {
+    let mut b = BuiltExtension {
+        fitted: None,
+        radius: None,
+        reestimated: None,
+        refit_failed: None,
+    };
+    match of {
+        FileOf::Candidate(c) => {
+            let plain = match refit_on_all(rec, tyre, opts, c) {
+                Ok(p) => p,
+                Err(e) => {
+                    b.refit_failed = Some(e.to_string());
+                    return b;
+                }
+            };
+            // The baseline fitted again beneath the extension when the
+            // diagnosis fitted it.
+            b.fitted = Some(match refit.filter(|_| c.reestimable()) {
+                Some(f) => {
+                    step("re-estimate baseline");
+                    let r = reestimate(rec, tyre, opts, c, plain, f);
+                    b.reestimated = Some((r.rounds, r.cost_plain, r.cost, r.failed));
+                    r.fitted
+                }
+                None => plain,
+            });
+        }
+        // A rolling-radius finding: the MF fitted again beneath the tyre's
+        // own Re(Fz) ([`beneath_rolling_radius`]).
+        FileOf::Radius(t) => {
+            if let Some(f) = refit {
+                step("re-estimate baseline");
+                let r = beneath_rolling_radius(rec, tyre, t, opts, f);
+                b.reestimated = Some((r.rounds, r.cost_plain, r.cost, r.failed));
+                b.radius = Some(r.tyre);
+            }
+        }
+    }
+    b
 }
 
 #[cfg(test)]

@@ -32,10 +32,10 @@
 use super::candidate::param::rerolled;
 use super::candidate::{
     all, also_qualifying, channels_in_words, evaluate, overshadowed_in_words, overshadowed_summary,
-    refit_on_all, select, why_not, Candidate, ChannelScore,
+    select, why_not, Candidate, ChannelScore,
 };
 use super::locate::{frictional_energy, locate, Finding, LocateOptions, Residuals};
-use super::reestimate::{beneath_rolling_radius, reestimate, Refit};
+use super::reestimate::{build_extended, FileOf, Refit};
 use super::slip_channel;
 use crate::data::Recording;
 use crate::error::Result;
@@ -185,6 +185,9 @@ pub struct Diagnosis {
     /// The same as JSON.
     pub json: Value,
     pub verdict: String,
+    /// The verdict is the slip channel's rolling-radius finding
+    /// ([`slip_channel`]), not a force candidate's.
+    pub by_slip: bool,
     pub explanation: String,
     pub extended: Tyre,
     /// Baseline and verdict's simulation, one per sample.
@@ -274,34 +277,16 @@ pub fn diagnose_with(
     // extended.tir: the verdict refitted on all segments once chosen
     // ([`refit_on_all`]); the held-out figures below stay the half fit's.
     // A refit that fails leaves the half fit in the file, and says so.
-    let mut refit_failed = None;
-    let mut reestimated = None;
-    let refit = verdict_i
-        .and_then(|i| owned.iter().find(|c| c.name() == ev[i].0.name))
-        .and_then(|c| {
-            let plain = refit_on_all(rec, tyre, opts, c.as_ref())
-                .map_err(|e| refit_failed = Some(e.to_string()))
-                .ok()?;
-            // The baseline fitted again beneath the extension
-            // ([`crate::diagnose::reestimate`]) when the diagnosis fitted it.
-            let Some(f) = refit_baseline.filter(|_| c.reestimable()) else {
-                return Some(plain);
-            };
-            step("re-estimate baseline");
-            let r = reestimate(rec, tyre, opts, c.as_ref(), plain, f);
-            reestimated = Some((r.rounds, r.cost_plain, r.cost, r.failed));
-            Some(r.fitted)
-        });
-    // A rolling-radius finding: the MF fitted again beneath the tyre's own
-    // Re(Fz) ([`crate::diagnose::reestimate::beneath_rolling_radius`]).
-    let slip_file = match (&slip_ext, slip_verdict, refit_baseline) {
-        (Some(t), true, Some(f)) => {
-            step("re-estimate baseline");
-            let r = beneath_rolling_radius(rec, tyre, t, opts, f);
-            reestimated = Some((r.rounds, r.cost_plain, r.cost, r.failed));
-            Some(r.tyre)
-        }
-        _ => None,
+    let of = match (&slip_ext, slip_verdict) {
+        (Some(t), true) => Some(FileOf::Radius(t)),
+        _ => verdict_i
+            .and_then(|i| owned.iter().find(|c| c.name() == ev[i].0.name))
+            .map(|c| FileOf::Candidate(c.as_ref())),
+    };
+    let built = of.map(|of| build_extended(rec, tyre, opts, of, refit_baseline, step));
+    let (refit, slip_file, reestimated, refit_failed) = match built {
+        Some(b) => (b.fitted, b.radius, b.reestimated, b.refit_failed),
+        None => (None, None, None, None),
     };
     let verdict = if slip_verdict {
         "rolling_radius".to_string()
@@ -513,6 +498,7 @@ pub fn diagnose_with(
         json: report.to_json(),
         report,
         verdict,
+        by_slip: slip_verdict,
         explanation,
         extended,
         baseline_sim: base.sim,

@@ -98,20 +98,23 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
     let for_d = for_diagnosis(Some(&b), recs.remove(0), Some(fitted_on));
     let rec = &for_d.rec;
     let refit = refit_fitted_baseline(threads);
-    let d = diagnose_with(
+    let mut d = diagnose_with(
         rec,
         &fitted,
         &ReplayOptions::default(),
-        for_d.fitted_on.as_ref().map(|r| Refit {
-            fit: &refit,
-            fitted_on: r,
-        }),
+        for_d
+            .fitted_on
+            .as_ref()
+            .filter(|_| for_d.measured.is_none())
+            .map(|r| Refit {
+                fit: &refit,
+                fitted_on: r,
+            }),
         &mut |_| {},
     )?;
     // extended.tir as the command writes it where the zeros were removed.
     if let Some(m) = &for_d.measured {
-        let mut report = d.report.clone();
-        extended_as_measured(&d, &fitted, m, &refit, &mut |_| {}, &mut report)?;
+        extended_as_measured(&mut d, &fitted, m, &refit, &mut |_| {})?;
     }
     let t_diag = t0.elapsed().as_secs_f64();
     let t0 = Instant::now();

@@ -205,24 +205,29 @@ pub fn run(a: Args) -> Result<()> {
     // beneath a named extension for extended.tir (diagnose::reestimate).
     let threads = a.manners.threads();
     let refit = refit_fitted_baseline(threads);
-    let d = diagnose_with(
+    // Where the zeros were removed the re-estimation runs once, for the
+    // file built as measured (sensor_zero::extended_as_measured).
+    let mut d = diagnose_with(
         &rec,
         &tyre,
         &ReplayOptions::default(),
-        fitted_on.as_ref().map(|r| Refit {
-            fit: &refit,
-            fitted_on: r,
-        }),
+        fitted_on
+            .as_ref()
+            .filter(|_| measured.is_none())
+            .map(|r| Refit {
+                fit: &refit,
+                fitted_on: r,
+            }),
         &mut step,
     )?;
-    let mut report = d.report.clone();
     let (mut base, mut ext) = match &measured {
         Some(m) => {
-            let ext = extended_as_measured(&d, &tyre, m, &refit, &mut step, &mut report)?;
+            let ext = extended_as_measured(&mut d, &tyre, m, &refit, &mut step)?;
             (m.tyre.clone(), ext)
         }
         None => (tyre.params().clone(), d.extended.params().clone()),
     };
+    let mut report = d.report.clone();
     prov.stamp(&mut base);
     base.write(&a.report.join("baseline.tir"))?;
     prov.lines.push(format!("diagnosis verdict: {}", d.verdict));

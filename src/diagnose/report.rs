@@ -114,6 +114,19 @@ pub struct BaselineReestimated {
     pub error_change: f64,
 }
 
+impl BaselineReestimated {
+    /// The sentence the explanation gets when a round was kept (leading
+    /// space), `None` otherwise.
+    pub fn in_words(&self) -> Option<String> {
+        (self.rounds > 0).then(|| format!(
+            " In extended.tir the baseline's Magic Formula was fitted again beneath the extension ({} round{}), which lowers the in-sample error by a further {:.1} %: the baseline had absorbed part of the effect. The held-out figures above compare the baseline as fitted without it.",
+            self.rounds,
+            if self.rounds == 1 { "" } else { "s" },
+            -100.0 * self.error_change
+        ))
+    }
+}
+
 /// `diagnosis.json`, typed.
 #[derive(Clone, Debug, Serialize)]
 pub struct DiagnosisReport {
@@ -404,13 +417,8 @@ pub fn diagnose_with(
         rounds,
         error_change: after / plain - 1.0,
     });
-    if let Some(r) = baseline_reestimated.as_ref().filter(|r| r.rounds > 0) {
-        explanation.push_str(&format!(
-            " In extended.tir the baseline's Magic Formula was fitted again beneath the extension ({} round{}), which lowers the in-sample error by a further {:.1} %: the baseline had absorbed part of the effect. The held-out figures above compare the baseline as fitted without it.",
-            r.rounds,
-            if r.rounds == 1 { "" } else { "s" },
-            -100.0 * r.error_change
-        ));
+    if let Some(w) = baseline_reestimated.as_ref().and_then(|r| r.in_words()) {
+        explanation.push_str(&w);
     }
     if let Some(w) = &slip_words {
         explanation = if slip_verdict {

@@ -412,7 +412,8 @@ fn with_sensor_zeros_the_file_built_as_measured_comes_nearer_the_truth() {
     let refit = refit_fitted_baseline(2);
     let opts = ReplayOptions::default();
     // As the command: no re-estimation in the diagnosis, once for the file.
-    let mut d = diagnose_with(&f.rec, &compared, &opts, None, &mut |_| {}).unwrap();
+    assert!(f.refit(&refit).is_none());
+    let mut d = diagnose_with(&f.rec, &compared, &opts, f.refit(&refit), &mut |_| {}).unwrap();
     assert_eq!(d.verdict, "load_sensitivity", "{}", d.explanation);
     let ext = extended_as_measured(&mut d, &compared, m, &refit, &mut |_| {}).unwrap();
     let rounds = d

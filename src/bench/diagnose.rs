@@ -15,7 +15,7 @@
 
 use crate::diagnose::baseline::{drop_unfitted, fit_baseline};
 use crate::diagnose::locate::frictional_energy;
-use crate::diagnose::reestimate::{refit_fitted_baseline, Refit};
+use crate::diagnose::reestimate::refit_fitted_baseline;
 use crate::diagnose::report::{diagnose_with, locate_channel};
 use crate::diagnose::sensor_zero::{extended_as_measured, for_diagnosis};
 use crate::diagnose::{html, plots};
@@ -102,14 +102,7 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
         rec,
         &fitted,
         &ReplayOptions::default(),
-        for_d
-            .fitted_on
-            .as_ref()
-            .filter(|_| for_d.measured.is_none())
-            .map(|r| Refit {
-                fit: &refit,
-                fitted_on: r,
-            }),
+        for_d.refit(&refit),
         &mut |_| {},
     )?;
     // extended.tir as the command writes it where the zeros were removed.

@@ -11,11 +11,9 @@
 
 use crate::data::ReChoice;
 use crate::diagnose::baseline::{drop_unfitted, fit_baseline, HELD_PRESSURE_KEYS};
-use crate::diagnose::reestimate::{refit_fitted_baseline, Refit};
+use crate::diagnose::reestimate::refit_fitted_baseline;
 use crate::diagnose::report::{diagnose_with, merge};
-use crate::diagnose::sensor_zero::{
-    extended_as_measured, for_diagnosis, ForDiagnosis, ZeroFinding,
-};
+use crate::diagnose::sensor_zero::{extended_as_measured, for_diagnosis, ZeroFinding};
 use crate::diagnose::{html, plots};
 use crate::fit::Progress;
 use crate::mf::Tyre;
@@ -184,11 +182,8 @@ pub fn run(a: Args) -> Result<()> {
     m.say(&note);
     // Where the zeros were removed, the diagnosis compares the recording
     // without them with the MF fitted without them.
-    let ForDiagnosis {
-        rec,
-        fitted_on,
-        measured,
-    } = for_diagnosis(fitted.as_ref(), merge(recs), fitted_on);
+    let for_d = for_diagnosis(fitted.as_ref(), merge(recs), fitted_on);
+    let rec = &for_d.rec;
     let steps = bar(m, 4, "{prefix:>12} [{bar:30}] {pos}/{len} {msg} {elapsed}");
     if let Some(b) = &steps {
         b.set_prefix("diagnose");
@@ -208,19 +203,13 @@ pub fn run(a: Args) -> Result<()> {
     // Where the zeros were removed the re-estimation runs once, for the
     // file built as measured (sensor_zero::extended_as_measured).
     let mut d = diagnose_with(
-        &rec,
+        rec,
         &tyre,
         &ReplayOptions::default(),
-        fitted_on
-            .as_ref()
-            .filter(|_| measured.is_none())
-            .map(|r| Refit {
-                fit: &refit,
-                fitted_on: r,
-            }),
+        for_d.refit(&refit),
         &mut step,
     )?;
-    let (mut base, mut ext) = match &measured {
+    let (mut base, mut ext) = match &for_d.measured {
         Some(m) => {
             let ext = extended_as_measured(&mut d, &tyre, m, &refit, &mut step)?;
             (m.tyre.clone(), ext)
@@ -233,7 +222,7 @@ pub fn run(a: Args) -> Result<()> {
     prov.lines.push(format!("diagnosis verdict: {}", d.verdict));
     prov.stamp(&mut ext);
     ext.write(&a.report.join("extended.tir"))?;
-    let pl = plots::draw_all(&rec, &d, &a.report)?;
+    let pl = plots::draw_all(rec, &d, &a.report)?;
     if let Some(b) = &steps {
         b.finish_and_clear();
     }

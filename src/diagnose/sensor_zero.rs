@@ -298,6 +298,19 @@ pub struct ForDiagnosis {
     pub measured: Option<AsMeasured>,
 }
 
+impl ForDiagnosis {
+    /// What [`super::report::diagnose_with`] gets to re-estimate the
+    /// baseline with `fit`: `None` where the zeros were removed — there the
+    /// re-estimation runs once, for the file built as measured
+    /// ([`extended_as_measured`]) — and without [`Self::fitted_on`].
+    pub fn refit<'a>(&'a self, fit: &'a RefitBaseline<'a>) -> Option<Refit<'a>> {
+        match (&self.measured, &self.fitted_on) {
+            (None, Some(r)) => Some(Refit { fit, fitted_on: r }),
+            _ => None,
+        }
+    }
+}
+
 /// The recordings for the diagnosis of the baseline `b` (`None`: a tyre
 /// given with `--tir`, compared as it is): `rec` the diagnosed recording
 /// (after [`super::baseline::drop_unfitted`]), `fitted_on` the one the
@@ -337,8 +350,8 @@ pub fn for_diagnosis(
 /// the corrected recording → −6 %). That mix remains only as the fallback
 /// when the rebuild fails, and then the explanation says so. The
 /// re-estimation runs here, on the file's recording, and not also in the
-/// diagnosis (give [`super::report::diagnose_with`] no [`Refit`] then:
-/// once is enough, and the two would double the time, r09 19.8 → 37.6 s):
+/// diagnosis ([`ForDiagnosis::refit`] gives it none then: once is
+/// enough, and the two would double the time, r09 19.8 → 37.6 s):
 /// `d`'s report gets the file's extended parameters and re-estimation, and
 /// its explanation the words for them.
 pub fn extended_as_measured(

@@ -115,15 +115,33 @@ pub struct BaselineReestimated {
 }
 
 impl BaselineReestimated {
-    /// The sentence the explanation gets when a round was kept (leading
-    /// space), `None` otherwise.
-    pub fn in_words(&self) -> Option<String> {
-        (self.rounds > 0).then(|| format!(
-            " In extended.tir the baseline's Magic Formula was fitted again beneath the extension ({} round{}), which lowers the in-sample error by a further {:.1} %: the baseline had absorbed part of the effect. The held-out figures above compare the baseline as fitted without it.",
-            self.rounds,
-            if self.rounds == 1 { "" } else { "s" },
-            -100.0 * self.error_change
-        ))
+    /// The report entry of a re-estimation's (rounds, plain cost, cost,
+    /// error that stopped it) ([`super::reestimate::BuiltExtension`]), and
+    /// the explanation's words for it (leading space; empty when no round
+    /// was kept and nothing failed).
+    pub fn of(r: Option<&(usize, f64, f64, Option<String>)>) -> (Option<Self>, String) {
+        let Some((rounds, plain, after, failed)) = r else {
+            return (None, String::new());
+        };
+        let mut w = String::new();
+        if let Some(e) = failed {
+            w.push_str(&format!(
+                " Re-estimating the baseline beneath the extension stopped on an error ({e}); extended.tir holds the best before it."
+            ));
+        }
+        if *rounds > 0 {
+            w.push_str(&format!(
+                " In extended.tir the baseline's Magic Formula was fitted again beneath the extension ({} round{}), which lowers the in-sample error by a further {:.1} %: the baseline had absorbed part of the effect. The held-out figures above compare the baseline as fitted without it.",
+                rounds,
+                if *rounds == 1 { "" } else { "s" },
+                -100.0 * (after / plain - 1.0)
+            ));
+        }
+        let entry = BaselineReestimated {
+            rounds: *rounds,
+            error_change: after / plain - 1.0,
+        };
+        (Some(entry), w)
     }
 }
 
@@ -408,18 +426,8 @@ pub fn diagnose_with(
             " extended.tir holds the half fit scored above: its refit on every segment failed ({e})."
         ));
     }
-    if let Some((_, _, _, Some(e))) = &reestimated {
-        explanation.push_str(&format!(
-            " Re-estimating the baseline beneath the extension stopped on an error ({e}); extended.tir holds the best before it."
-        ));
-    }
-    let baseline_reestimated = reestimated.map(|(rounds, plain, after, _)| BaselineReestimated {
-        rounds,
-        error_change: after / plain - 1.0,
-    });
-    if let Some(w) = baseline_reestimated.as_ref().and_then(|r| r.in_words()) {
-        explanation.push_str(&w);
-    }
+    let (baseline_reestimated, w) = BaselineReestimated::of(reestimated.as_ref());
+    explanation.push_str(&w);
     if let Some(w) = &slip_words {
         explanation = if slip_verdict {
             format!("{w} (The force residuals alone name nothing: {explanation})")

@@ -400,19 +400,7 @@ pub fn extended_as_measured(
             if let Some(f) = &b.fitted {
                 d.report.extended_parameters = Some(f.parameters().into_iter().collect());
             }
-            let r = b
-                .reestimated
-                .as_ref()
-                .map(|(rounds, plain, after, _)| BaselineReestimated {
-                    rounds: *rounds,
-                    error_change: after / plain - 1.0,
-                });
-            let mut w = r.as_ref().and_then(|r| r.in_words()).unwrap_or_default();
-            if let Some((_, _, _, Some(e))) = &b.reestimated {
-                w.push_str(&format!(
-                    " Re-estimating the baseline beneath the extension stopped on an error ({e}); extended.tir holds the best before it."
-                ));
-            }
+            let (r, w) = BaselineReestimated::of(b.reestimated.as_ref());
             d.report.baseline_reestimated = r;
             Ok(w)
         }

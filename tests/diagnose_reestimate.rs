@@ -16,11 +16,10 @@
 mod common;
 
 use tyrekit::data::{Recording, Sample, SegmentKind};
-use tyrekit::diagnose::baseline::{drop_unfitted, fit_baseline};
-use tyrekit::diagnose::reestimate::{refit_fitted_baseline, Refit};
+use tyrekit::diagnose::baseline::fit_baseline;
+use tyrekit::diagnose::case;
 use tyrekit::diagnose::replay::{replay, ReplayOptions};
-use tyrekit::diagnose::report::{diagnose_with, Diagnosis};
-use tyrekit::diagnose::sensor_zero::for_diagnosis;
+use tyrekit::diagnose::report::Diagnosis;
 use tyrekit::mf::Tyre;
 use tyrekit::rig::effects::{Scaling, ScalingKind};
 use tyrekit::rig::{simulate, RigConfig};
@@ -62,28 +61,18 @@ fn lateral_error(
 /// does), and the diagnosis without and with the re-estimation:
 /// (recording, baseline, plain, re-estimated).
 fn fitted_and_diagnosed(rec: Recording) -> (Recording, Tyre, Diagnosis, Diagnosis) {
-    let mut recs = vec![rec];
+    let recs = vec![rec];
     let b = fit_baseline(&recs, 2, None).unwrap();
-    let fitted_on = recs[0].clone();
-    drop_unfitted(&mut recs, &b);
-    let f = for_diagnosis(Some(&b), recs.pop().unwrap(), Some(fitted_on));
-    let (rec, fitted_on) = (f.rec, f.fitted_on.unwrap());
-    let base = Tyre::new(b.compared().clone()).unwrap();
-    let opts = ReplayOptions::default();
-    let plain = diagnose_with(&rec, &base, &opts, None, &mut |_| {}).unwrap();
-    let refit = refit_fitted_baseline(2);
-    let re = diagnose_with(
-        &rec,
-        &base,
-        &opts,
-        Some(Refit {
-            fit: &refit,
-            fitted_on: &fitted_on,
-        }),
-        &mut |_| {},
+    let plain = case::Case::fitted(&b, recs.clone(), false).unwrap();
+    let re = case::Case::fitted(&b, recs, true).unwrap();
+    // The diagnosis compares the same recording with the same tyre either way.
+    assert_eq!(plain.rec().samples.len(), re.rec().samples.len());
+    (
+        re.rec().clone(),
+        re.compared().clone(),
+        plain.diagnose(2, &mut |_| {}).unwrap().diagnosis,
+        re.diagnose(2, &mut |_| {}).unwrap().diagnosis,
     )
-    .unwrap();
-    (rec, base, plain, re)
 }
 
 /// One case: the rig's `truth_model` over the standard programme (one
@@ -358,7 +347,7 @@ fn refitting_beneath_a_rolling_radius_finding_comes_nearer_the_truth_from_the_wh
 /// the keys it left alone: dev set r09 gap 42 → 37 %).
 #[test]
 fn with_sensor_zeros_the_file_built_as_measured_comes_nearer_the_truth() {
-    use tyrekit::diagnose::sensor_zero::{as_measured, extended_as_measured};
+    use tyrekit::diagnose::sensor_zero::as_measured;
     let tyre = Tyre::builtin();
     let mut cfg = RigConfig::standard(&tyre, 41);
     cfg.noise = tyrekit::rig::Noise::none();
@@ -377,7 +366,7 @@ fn with_sensor_zeros_the_file_built_as_measured_comes_nearer_the_truth() {
         s.fy += fy0;
         s.mz += mz0;
     }
-    let mut recs = vec![rec];
+    let recs = vec![rec];
     let b = fit_baseline(&recs, 2, None).unwrap();
     let fy_found = b.zeros.fy.unwrap_or(f64::NAN);
     assert!(
@@ -392,12 +381,9 @@ fn with_sensor_zeros_the_file_built_as_measured_comes_nearer_the_truth() {
         (fy_found - fy0).abs() < 15.0,
         "Fy zero {fy_found:.1} N, added {fy0} N"
     );
-    let fitted_on = recs[0].clone();
-    drop_unfitted(&mut recs, &b);
-    let f = for_diagnosis(Some(&b), recs.pop().unwrap(), Some(fitted_on));
-    let m = f
-        .measured
-        .as_ref()
+    let prepared = case::Case::fitted(&b, recs, true).unwrap();
+    let m = prepared
+        .measured()
         .expect("the recordings as measured are kept");
     let raw = &m.rec;
     // The diagnosis sees the recording without the zeros.
@@ -407,15 +393,15 @@ fn with_sensor_zeros_the_file_built_as_measured_comes_nearer_the_truth() {
         .enumerate()
         .find(|(_, s)| s.fy.is_finite())
         .unwrap();
-    assert!((f.rec.samples[i].fy - (s.fy - fy_found)).abs() < 1e-9);
-    let compared = Tyre::new(b.compared().clone()).unwrap();
-    let refit = refit_fitted_baseline(2);
-    let opts = ReplayOptions::default();
-    // As the command: no re-estimation in the diagnosis, once for the file.
-    assert!(f.refit(&refit).is_none());
-    let mut d = diagnose_with(&f.rec, &compared, &opts, f.refit(&refit), &mut |_| {}).unwrap();
+    assert!((prepared.rec().samples[i].fy - (s.fy - fy_found)).abs() < 1e-9);
+    let compared = prepared.compared().clone();
+    assert_eq!(compared.params().p.as_slice(), b.compared().p.as_slice());
+    let out = prepared.diagnose(2, &mut |_| {}).unwrap();
+    let (d, ext) = (out.diagnosis, out.extended_file);
     assert_eq!(d.verdict, "load_sensitivity", "{}", d.explanation);
-    let ext = extended_as_measured(&mut d, &compared, m, &refit, &mut |_| {}).unwrap();
+    // baseline.tir is the first fit, to the recording as measured.
+    assert_eq!(out.baseline_file.p.as_slice(), b.tyre.p.as_slice());
+    // As the command: no re-estimation in the diagnosis, once for the file.
     let rounds = d
         .report
         .baseline_reestimated

@@ -13,11 +13,10 @@
 //!
 //! Must never: assert on timings (figures are reported, not checked).
 
-use crate::diagnose::baseline::{drop_unfitted, fit_baseline};
+use crate::diagnose::baseline::fit_baseline;
+use crate::diagnose::case::Case;
 use crate::diagnose::locate::frictional_energy;
-use crate::diagnose::reestimate::refit_fitted_baseline;
-use crate::diagnose::report::{diagnose_with, locate_channel};
-use crate::diagnose::sensor_zero::{extended_as_measured, for_diagnosis};
+use crate::diagnose::report::locate_channel;
 use crate::diagnose::{html, plots};
 use crate::mf::Tyre;
 use crate::residual::{replay, Channel, ReplayOptions};
@@ -76,12 +75,10 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
 
     // The pipeline as `tyrekit diagnose` runs it without --tir.
     let t_all = Instant::now();
-    let mut recs = vec![rec];
+    let recs = vec![rec];
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let t0 = Instant::now();
     let b = fit_baseline(&recs, threads, None)?;
-    let fitted_on = recs[0].clone();
-    drop_unfitted(&mut recs, &b);
     let t_fit = t0.elapsed().as_secs_f64();
     println!(
         "[diagnose] baseline fit (every {}. sample) {t_fit:8.3} s; sensor zeros {} ({})",
@@ -93,22 +90,10 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
             "left to the MF's shifts"
         }
     );
-    let fitted = Tyre::new(b.compared().clone())?;
     let t0 = Instant::now();
-    let for_d = for_diagnosis(Some(&b), recs.remove(0), Some(fitted_on));
-    let rec = &for_d.rec;
-    let refit = refit_fitted_baseline(threads);
-    let mut d = diagnose_with(
-        rec,
-        &fitted,
-        &ReplayOptions::default(),
-        for_d.refit(&refit),
-        &mut |_| {},
-    )?;
-    // extended.tir as the command writes it where the zeros were removed.
-    if let Some(m) = &for_d.measured {
-        extended_as_measured(&mut d, &fitted, m, &refit, &mut |_| {})?;
-    }
+    let case = Case::fitted(&b, recs, true)?;
+    let rec = case.rec();
+    let d = case.diagnose(threads, &mut |_| {})?.diagnosis;
     let t_diag = t0.elapsed().as_secs_f64();
     let t0 = Instant::now();
     let pl = plots::draw_all(rec, &d, &dir)?;

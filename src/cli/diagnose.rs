@@ -10,14 +10,11 @@
 //! progress when stderr is not a terminal.
 
 use crate::data::ReChoice;
-use crate::diagnose::baseline::{drop_unfitted, fit_baseline, HELD_PRESSURE_KEYS};
-use crate::diagnose::reestimate::refit_fitted_baseline;
-use crate::diagnose::report::{diagnose_with, merge};
-use crate::diagnose::sensor_zero::{extended_as_measured, for_diagnosis, ZeroFinding};
+use crate::diagnose::baseline::{fit_baseline, HELD_PRESSURE_KEYS};
+use crate::diagnose::case::{Case, Outcome};
+use crate::diagnose::sensor_zero::ZeroFinding;
 use crate::diagnose::{html, plots};
 use crate::fit::Progress;
-use crate::mf::Tyre;
-use crate::residual::ReplayOptions;
 use crate::{Error, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
@@ -81,7 +78,7 @@ pub fn run(a: Args) -> Result<()> {
             None => ReChoice::FreeRolling,
         };
     }
-    let mut recs: Vec<_> = crate::cli::data::load_all(&a.recordings, &opts, "diagnose")?
+    let recs: Vec<_> = crate::cli::data::load_all(&a.recordings, &opts, "diagnose")?
         .into_iter()
         .map(|l| l.recording)
         .collect();
@@ -89,15 +86,11 @@ pub fn run(a: Args) -> Result<()> {
     inputs.extend(a.tir.iter().cloned());
     let mut prov = crate::tir::provenance::Provenance::of_inputs(&inputs)?;
     std::fs::create_dir_all(&a.report).map_err(|e| Error::io(&a.report, e))?;
-    // The recording as the baseline was fitted on, before drop_unfitted.
-    let mut fitted_on = None;
-    // The sensor zeros found, and the baseline fit (its zeros decide what
-    // the diagnosis compares: sensor_zero::for_diagnosis).
+    // The sensor zeros found by the baseline fit (reported).
     let mut sensor_zeros = None;
-    let mut fitted = None;
-    let (tyre, note) = match (&a.tir, given) {
+    let (case, note) = match (&a.tir, given) {
         (Some(tir), Some(t)) => (
-            t,
+            Case::given(t, recs),
             format!("Baseline: {} (given with --tir).", tir.display()),
         ),
         _ => {
@@ -129,10 +122,8 @@ pub fn run(a: Args) -> Result<()> {
                 crate::fit::mf_fit::overall_sigma(&fit.report.metrics, ch)
                     .map_or("–".into(), |v| format!("{:.1} %", 100.0 * v))
             };
-            if !a.keep_baseline {
-                fitted_on = Some(merge(recs.clone()));
-            }
-            let dropped = drop_unfitted(&mut recs, &fit);
+            let case = Case::fitted(&fit, recs, !a.keep_baseline)?;
+            let dropped = &case.dropped;
             let mut note = format!(
                 "Baseline: steady MF 6.1 fitted to the recordings (every {}. sample; σ Fx {}, Fy {}, Mz {}), started from the built-in tyre with FNOMIN/NOMPRES/LONGVL from the data; each channel diagnosed on the segment kinds it was fitted on (Mz on cornering only); held (so the candidates can name them): relaxation lengths, pressure terms {} (0, data pooled at the median pressure), LMUV and all scaling factors, BREFF/DREFF/FREFF.",
                 fit.stride,
@@ -173,17 +164,12 @@ pub fn run(a: Args) -> Result<()> {
                 fit_gain: fit.zero_fit_gain,
                 removed: fit.zeroed.is_some(),
             });
-            let compared = Tyre::new(fit.compared().clone())?;
-            fitted = Some(fit);
-            (compared, note)
+            (case, note)
         }
     };
     let m = &a.manners;
     m.say(&note);
-    // Where the zeros were removed, the diagnosis compares the recording
-    // without them with the MF fitted without them.
-    let for_d = for_diagnosis(fitted.as_ref(), merge(recs), fitted_on);
-    let rec = &for_d.rec;
+    let rec = case.rec();
     let steps = bar(m, 4, "{prefix:>12} [{bar:30}] {pos}/{len} {msg} {elapsed}");
     if let Some(b) = &steps {
         b.set_prefix("diagnose");
@@ -196,26 +182,13 @@ pub fn run(a: Args) -> Result<()> {
             b.set_message(s.to_string());
         }
     };
-    // Without --tir the diagnosis fitted the baseline, and fits it again
-    // beneath a named extension for extended.tir (diagnose::reestimate).
-    let threads = a.manners.threads();
-    let refit = refit_fitted_baseline(threads);
-    // Where the zeros were removed the re-estimation runs once, for the
-    // file built as measured (sensor_zero::extended_as_measured).
-    let mut d = diagnose_with(
-        rec,
-        &tyre,
-        &ReplayOptions::default(),
-        for_d.refit(&refit),
-        &mut step,
-    )?;
-    let (mut base, mut ext) = match &for_d.measured {
-        Some(m) => {
-            let ext = extended_as_measured(&mut d, &tyre, m, &refit, &mut step)?;
-            (m.tyre.clone(), ext)
-        }
-        None => (tyre.params().clone(), d.extended.params().clone()),
-    };
+    // Without --tir the baseline is fitted again beneath a named extension
+    // for extended.tir (diagnose::case).
+    let Outcome {
+        diagnosis: d,
+        baseline_file: mut base,
+        extended_file: mut ext,
+    } = case.diagnose(a.manners.threads(), &mut step)?;
     let mut report = d.report.clone();
     prov.stamp(&mut base);
     base.write(&a.report.join("baseline.tir"))?;

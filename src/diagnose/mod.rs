@@ -16,6 +16,7 @@
 
 pub mod baseline;
 pub mod candidate;
+pub mod case;
 mod explain;
 pub mod factor;
 pub mod html;

@@ -248,19 +248,19 @@ pub fn run(ctx: &BenchContext) -> crate::Result<()> {
     println!("[mf] Tyre::forces_mu (road friction scale 0.6):      {ns_mu:8.1} ns/eval");
     println!("[mf] Tyre::slip_properties (zero-slip Re, C, K, σ, μ): {ns_props:8.1} ns/eval");
     let ns_xy = time_ns(&inp, reps, |x| {
-        let (fx, fy) = tyre.forces_xy_mu(x, mode, 1.0);
+        let (fx, fy) = tyre.forces_xy(x, mode, 1.0, None);
         fx + fy
     });
     let ns_parts = time_ns(&inp, reps, |x| {
-        tyre.slip_properties_parts(x, mode, 1.0, false, true).kya
+        tyre.slip_properties_terms(x, mode, 1.0, false, true).0.kya
     });
     let ns_radius = time_ns(&inp, reps, |x| tyre.zero_slip_radius(x, mode));
     let ns_fp = time_ns(&inp, reps, |x| {
         let (f, p) = tyre.forces_and_props(x, mode, 1.0);
         sum(f) + p.sigmay
     });
-    println!("[mf] Tyre::forces_xy_mu (Fx Fy only, no moments):     {ns_xy:8.1} ns/eval");
-    println!("[mf] Tyre::slip_properties_parts (no Fx Fy; the transient models' probe): {ns_parts:8.1} ns/eval");
+    println!("[mf] Tyre::forces_xy (Fx Fy only, no moments):        {ns_xy:8.1} ns/eval");
+    println!("[mf] Tyre::slip_properties_terms (no Fx Fy; the transient models' probe): {ns_parts:8.1} ns/eval");
     println!("[mf] the steady step's MF: Tyre::zero_slip_radius {ns_radius:.1} ns + Tyre::forces_and_props {ns_fp:.1} ns");
     // A fully populated MF 6.1 file (every curvature factor and shift non-zero,
     // so none of the zero-coefficient shortcuts applies), when the shared data

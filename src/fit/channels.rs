@@ -23,8 +23,8 @@ pub fn eval<T: Real>(model: &Model<T>, c: &Conditions, channel: Channel) -> T {
         Channel::My => model.my_only(c),
         // Mz needs the combined Fx, Fy and the trail: the full solution,
         // without the rolling resistance moment it does not use
-        // (`solve_parts`: every other field the same bits as `solve`).
-        Channel::Mz => model.solve_parts(c, 1.0, false).mz,
+        // (`solve_with`: every other field the same bits as `solve`).
+        Channel::Mz => model.solve_with(c, 1.0, false, None).mz,
         // Fz is the model's input, not a predicted channel (as `Channel::of`).
         Channel::Fz => T::from(f64::NAN),
     }

@@ -131,7 +131,7 @@ struct Spin<T> {
 /// its sin(PKY4·atan(…))), as [`Model::zero_slip_terms`] computed them. A
 /// transient step evaluates the MF several times at the same Fz, p, γ (its
 /// zero-slip probe, the forces, slopes, cross terms): handing these to the
-/// later evaluations ([`Model::solve_with`], [`Model::solve_fxfy_with`])
+/// later evaluations ([`Model::solve_with`], [`Model::solve_fxfy`])
 /// computes them once per step. They carry the conditioned Fz, p, γ, γ* and
 /// friction scale they belong to and are used only where all match (else
 /// computed afresh), so results are bit-identical either way. Not a cache:
@@ -644,21 +644,17 @@ impl<T: Real> Model<T> {
     /// κ-induced side force SVyκ is 0 (Pacejka 3rd ed. 4.E51, 4.E59, 4.E66),
     /// so Fx = Fx0, Fy = Fy0 — without the weights and the Mx, Mz equations.
     pub fn zero_slip(&self, c: &Conditions, mu_scale: f64) -> [T; 7] {
-        self.zero_slip_parts(c, mu_scale, true, true)
+        self.zero_slip_terms(c, mu_scale, true, true).0
     }
 
-    /// [`Model::zero_slip`] computing only what is asked for: μx, μy, Kxκ,
-    /// Kyα always; Fx, Fy at zero slip only with `forces`, My only with `my`
-    /// (the others are NaN). What is computed has the same bits as in
-    /// [`Model::zero_slip`] (the same operations on the same operands); the
-    /// skipped parts are the Magic Formula's sin(C·atan(…)) of 4.E9/4.E19 and
-    /// the rolling-resistance powers — most of the probe's cost.
-    pub fn zero_slip_parts(&self, c: &Conditions, mu_scale: f64, forces: bool, my: bool) -> [T; 7] {
-        self.zero_slip_terms(c, mu_scale, forces, my).0
-    }
-
-    /// [`Model::zero_slip_parts`] plus the slip-independent terms it
-    /// computed, for the step's later evaluations ([`LoadTerms`]).
+    /// [`Model::zero_slip`] computing only what is asked for, and the
+    /// slip-independent terms it computed, for the step's later evaluations
+    /// ([`LoadTerms`]): μx, μy, Kxκ, Kyα always; Fx, Fy at zero slip only
+    /// with `forces`, My only with `my` (the others are NaN). What is
+    /// computed has the same bits as in [`Model::zero_slip`] (the same
+    /// operations on the same operands); the skipped parts are the Magic
+    /// Formula's sin(C·atan(…)) of 4.E9/4.E19 and the rolling-resistance
+    /// powers — most of the probe's cost.
     pub fn zero_slip_terms(
         &self,
         c: &Conditions,
@@ -704,18 +700,10 @@ impl<T: Real> Model<T> {
     /// need no more: finite-difference slopes, the transient models'
     /// zero-slip offsets and LuGre's cross terms): the same operations as
     /// [`Model::solve_mu`]'s Fx, Fy, so the same bits, at well under its cost
-    /// (no Mz ingredients, no second Fy0 at γ = 0, no Mx, My).
-    pub fn solve_fxfy(&self, c: &Conditions, mu_scale: f64) -> (T, T) {
-        self.solve_fxfy_with(c, mu_scale, None)
-    }
-
-    /// [`Model::solve_fxfy`] with the step's [`LoadTerms`] (same bits).
-    pub fn solve_fxfy_with(
-        &self,
-        c: &Conditions,
-        mu_scale: f64,
-        pre: Option<&LoadTerms<T>>,
-    ) -> (T, T) {
+    /// (no Mz ingredients, no second Fy0 at γ = 0, no Mx, My). `pre`: the
+    /// step's [`LoadTerms`] where they belong to the same Fz, p, γ (same
+    /// bits either way).
+    pub fn solve_fxfy(&self, c: &Conditions, mu_scale: f64, pre: Option<&LoadTerms<T>>) -> (T, T) {
         let mut fl = 0u32;
         let r = self.pure(c, mu_scale, true, true, pre, &mut fl);
         let (fx, fy, _, _) = self.combined(c, &r, &mut fl);
@@ -802,17 +790,14 @@ impl<T: Real> Model<T> {
     /// contain λμ, so the small-slip stiffness is unchanged. `mu_scale = 1`
     /// gives bit-identical results to [`Model::solve`] (×1 is exact).
     pub fn solve_mu(&self, c: &Conditions, mu_scale: f64) -> Solution<T> {
-        self.solve_parts(c, mu_scale, true)
+        self.solve_with(c, mu_scale, true, None)
     }
 
     /// [`Model::solve_mu`] with My only when `my` (NaN otherwise; the
-    /// transient models take My from their zero-slip probe); every other
-    /// field the same bits (the same operations).
-    pub fn solve_parts(&self, c: &Conditions, mu_scale: f64, my: bool) -> Solution<T> {
-        self.solve_with(c, mu_scale, my, None)
-    }
-
-    /// [`Model::solve_parts`] with the step's [`LoadTerms`] (same bits).
+    /// transient models take My from their zero-slip probe, the fitter's Mz
+    /// stage needs none), reusing the step's [`LoadTerms`] `pre` where they
+    /// belong to the same Fz, p, γ; every other field the same bits (the
+    /// same operations).
     pub fn solve_with(
         &self,
         c: &Conditions,

@@ -461,20 +461,14 @@ impl Tyre {
     /// (see [`Tyre::evaluate_mu`]); `mu_scale = 1` is bit-identical.
     #[inline]
     pub fn forces_mu(&self, inp: &MfInput, mode: UseMode, mu_scale: f64) -> Forces {
-        self.forces_parts(inp, mode, mu_scale, true)
+        self.forces_with(inp, mode, mu_scale, true, None)
     }
 
     /// [`Tyre::forces_mu`] with My only when `my` (NaN otherwise,
-    /// [`Model::solve_parts`]); the other fields bit-identical.
-    /// Allocation-free.
-    #[inline]
-    pub fn forces_parts(&self, inp: &MfInput, mode: UseMode, mu_scale: f64, my: bool) -> Forces {
-        self.forces_with(inp, mode, mu_scale, my, None)
-    }
-
-    /// [`Tyre::forces_parts`] reusing the slip-independent terms of this
-    /// step's probe ([`Tyre::slip_properties_terms`], [`LoadTerms`]; used only
-    /// where they belong to the same Fz, p, γ; the same bits either way).
+    /// [`Model::solve_with`]), reusing the slip-independent terms `pre` of
+    /// this step's probe ([`Tyre::slip_properties_terms`], [`LoadTerms`];
+    /// used only where they belong to the same Fz, p, γ); the other fields
+    /// bit-identical either way. Allocation-free.
     #[inline]
     pub fn forces_with(
         &self,
@@ -496,17 +490,10 @@ impl Tyre {
     }
 
     /// Fx and Fy of [`Tyre::forces_mu`] only (bit-identical to its `fx`,
-    /// `fy`), without the moment equations ([`Model::solve_fxfy`]).
-    /// Allocation-free.
+    /// `fy`), without the moment equations ([`Model::solve_fxfy`]); `pre`
+    /// as in [`Tyre::forces_with`]. Allocation-free.
     #[inline]
-    pub fn forces_xy_mu(&self, inp: &MfInput, mode: UseMode, mu_scale: f64) -> (f64, f64) {
-        self.forces_xy_with(inp, mode, mu_scale, None)
-    }
-
-    /// [`Tyre::forces_xy_mu`] with the step's [`LoadTerms`] (see
-    /// [`Tyre::forces_with`]; the same bits).
-    #[inline]
-    pub fn forces_xy_with(
+    pub fn forces_xy(
         &self,
         inp: &MfInput,
         mode: UseMode,
@@ -514,7 +501,7 @@ impl Tyre {
         pre: Option<&LoadTerms<f64>>,
     ) -> (f64, f64) {
         let (c, _) = self.conditions(inp, mode);
-        self.model.solve_fxfy_with(&c, mu_scale, pre)
+        self.model.solve_fxfy(&c, mu_scale, pre)
     }
 
     /// The zero-slip properties the transient models need each step,
@@ -522,30 +509,18 @@ impl Tyre {
     /// [`Tyre::evaluate_mu`] gives for the same input with κ = α = 0
     /// (bit-identical; the other inputs as given, ω estimated the same way).
     pub fn slip_properties_mu(&self, inp: &MfInput, mode: UseMode, mu_scale: f64) -> SlipProps {
-        self.slip_properties_parts(inp, mode, mu_scale, true, true)
-    }
-
-    /// [`Tyre::slip_properties_mu`] computing Fx, Fy (at zero slip) only with
-    /// `forces` and My only with `my` (NaN otherwise); every other field, and
-    /// those asked for, bit-identical to [`Tyre::slip_properties_mu`]. The
-    /// transient step asks only for what its model uses (see
-    /// `transient::TransientModel::step`): the skipped force equations are
-    /// most of the probe's cost.
-    pub fn slip_properties_parts(
-        &self,
-        inp: &MfInput,
-        mode: UseMode,
-        mu_scale: f64,
-        forces: bool,
-        my: bool,
-    ) -> SlipProps {
-        self.slip_properties_terms(inp, mode, mu_scale, forces, my)
+        self.slip_properties_terms(inp, mode, mu_scale, true, true)
             .0
     }
 
-    /// [`Tyre::slip_properties_parts`] plus the slip-independent terms it
-    /// computed ([`LoadTerms`]), for the step's later evaluations
-    /// ([`Tyre::forces_with`], [`Tyre::forces_xy_with`]).
+    /// [`Tyre::slip_properties_mu`] computing Fx, Fy (at zero slip) only with
+    /// `forces` and My only with `my` (NaN otherwise), and the
+    /// slip-independent terms it computed ([`LoadTerms`]) for the step's
+    /// later evaluations ([`Tyre::forces_with`], [`Tyre::forces_xy`]); every
+    /// other field, and those asked for, bit-identical to
+    /// [`Tyre::slip_properties_mu`]. The transient step asks only for what
+    /// its model uses (see `transient::TransientModel::step`): the skipped
+    /// force equations are most of the probe's cost.
     pub fn slip_properties_terms(
         &self,
         inp: &MfInput,
@@ -784,8 +759,8 @@ mod tests {
                         alpha,
                         ..base
                     };
-                    let want = tyre.forces_parts(&inp, mode, 1.0, false);
-                    let want_xy = tyre.forces_xy_mu(&inp, mode, 1.0);
+                    let want = tyre.forces_with(&inp, mode, 1.0, false, None);
+                    let want_xy = tyre.forces_xy(&inp, mode, 1.0, None);
                     for pre in [&own, &foreign] {
                         let got = tyre.forces_with(&inp, mode, 1.0, false, Some(pre));
                         for (a, b) in [
@@ -797,7 +772,7 @@ mod tests {
                         ] {
                             assert_eq!(bits(a), bits(b), "mode {code} {inp:?}");
                         }
-                        let xy = tyre.forces_xy_with(&inp, mode, 1.0, Some(pre));
+                        let xy = tyre.forces_xy(&inp, mode, 1.0, Some(pre));
                         assert_eq!(bits(xy.0), bits(want_xy.0));
                         assert_eq!(bits(xy.1), bits(want_xy.1));
                         used += 1;
@@ -806,7 +781,7 @@ mod tests {
                     let mu = tyre.forces_with(&inp, mode, 0.6, false, Some(&own));
                     assert_eq!(
                         bits(mu.fy),
-                        bits(tyre.forces_parts(&inp, mode, 0.6, false).fy)
+                        bits(tyre.forces_with(&inp, mode, 0.6, false, None).fy)
                     );
                 }
             }

@@ -42,7 +42,7 @@
 //!    of an asymmetric curve and a settled transient tyre equals the steady
 //!    one in reverse. `Steady` calls the MF as is.
 //! 3. Below VXLOW only: Fx, Fy at zero slip at the raised speed (the moment-free
-//!    [`Tyre::forces_xy_mu`], as LuGre's cross terms and the non-linear slopes), so that
+//!    [`Tyre::forces_xy`], as LuGre's cross terms and the non-linear slopes), so that
 //!    the MF's force at zero slip (shifts, camber thrust) keeps the MF's own
 //!    low-speed reduction (`StepCtx::offset_correction`).
 //!
@@ -82,7 +82,7 @@ pub use similarity::{mf_at, mf_at_xy, Slip};
 use crate::mf::{Forces, LoadTerms, MfInput, SlipProps, Tyre, UseMode};
 use props::rolling_radius;
 use relaxation::{relax_linear, relax_nonlinear};
-use similarity::{mf_at_no_my, mf_at_props, mf_at_xy_with, stiff_slip};
+use similarity::{mf_at_no_my, mf_at_props, stiff_slip};
 
 /// The speed (m/s) at which the Magic Formula is evaluated for vx = 0 with
 /// turn slip on: the limit vx → 0+ (see [`TransientModel::step`]).
@@ -411,7 +411,7 @@ impl StepCtx<'_> {
             ..sl
         };
         let pre = self.terms.as_ref();
-        mf_at_xy_with(self.tyre, base, self.mode, self.stiff(sl), self.s, pre)
+        mf_at_xy(self.tyre, base, self.mode, self.stiff(sl), self.s, pre)
     }
 
     /// Low-speed offset correction (N): the MF's force at zero slip at the

@@ -67,15 +67,10 @@ fn similar_forces(mut o: Forces, s: f64) -> Forces {
 }
 
 /// Fx, Fy of [`mf_at`] only (bit-identical to its), without the moment
-/// equations ([`Tyre::forces_xy_mu`]).
+/// equations ([`Tyre::forces_xy`]); `pre`: the step's [`LoadTerms`] where
+/// they belong to the same Fz, p, γ (the same bits either way).
 #[inline]
-pub fn mf_at_xy(tyre: &Tyre, base: &MfInput, mode: UseMode, slip: Slip, s: f64) -> (f64, f64) {
-    mf_at_xy_with(tyre, base, mode, slip, s, None)
-}
-
-/// [`mf_at_xy`] with the step's [`LoadTerms`] (the same bits).
-#[inline]
-pub(crate) fn mf_at_xy_with(
+pub fn mf_at_xy(
     tyre: &Tyre,
     base: &MfInput,
     mode: UseMode,
@@ -83,7 +78,7 @@ pub(crate) fn mf_at_xy_with(
     s: f64,
     pre: Option<&LoadTerms<f64>>,
 ) -> (f64, f64) {
-    let (fx, fy) = tyre.forces_xy_with(&similar_input(base, slip, s), mode, 1.0, pre);
+    let (fx, fy) = tyre.forces_xy(&similar_input(base, slip, s), mode, 1.0, pre);
     if s != 1.0 {
         (fx * s, fy * s)
     } else {

@@ -243,6 +243,7 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
                 &opts,
                 "pure Fy",
                 None,
+                &[],
             )?;
             best = best.min(t0.elapsed().as_secs_f64());
             best_cpu = best_cpu.min((super::mf::cpu_ns() - c0) * 1e-9);

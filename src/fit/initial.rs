@@ -4,7 +4,7 @@
 //! slip K, the asymptote at large slip and the slip of the peak; from them
 //! C, B = K/(CD) and E, then the load trends (D/Fz and E linear in dfz, K by
 //! its MF 6.1 load law). One more start for a stage's multi-start
-//! ([`super::mf_stages::fit_stage_from`]), far from the start tyre's basin
+//! ([`super::mf_stages::fit_stage`]), far from the start tyre's basin
 //! when the start tyre is a different tyre.
 //!
 //! Equations: Pacejka, *Tyre and Vehicle Dynamics*, 3rd ed., pure slip

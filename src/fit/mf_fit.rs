@@ -10,7 +10,7 @@
 use super::holdout::Holdout;
 use super::metrics::{self, ChannelMetric};
 use super::mf_stages::{
-    conditions_of, fit_stage_from, gather, neutral_start, stage_params, Channel, StageKind,
+    conditions_of, fit_stage, gather, neutral_start, stage_params, Channel, StageKind,
     CAMBER_SPREAD, PRESSURE_SPREAD,
 };
 use super::report::FitReport;
@@ -496,7 +496,7 @@ pub(crate) fn run_stage(
             extra.push(s);
         }
     }
-    let out = fit_stage_from(
+    let out = fit_stage(
         ctx.form,
         &tyre.p,
         &params,

@@ -399,6 +399,13 @@ fn with_sensor_zeros_the_file_built_as_measured_comes_nearer_the_truth() {
     let out = prepared.diagnose(2, &mut |_| {}).unwrap();
     let (d, ext) = (out.diagnosis, out.extended_file);
     assert_eq!(d.verdict, "load_sensitivity", "{}", d.explanation);
+    // The report says which zeros were found and that they were removed.
+    let z = d
+        .report
+        .sensor_zeros
+        .as_ref()
+        .expect("sensor_zeros reported");
+    assert!(z.removed && z.zeros == b.zeros, "{z:?}");
     // baseline.tir is the first fit, to the recording as measured.
     assert_eq!(out.baseline_file.p.as_slice(), b.tyre.p.as_slice());
     // As the command: no re-estimation in the diagnosis, once for the file.

@@ -12,7 +12,6 @@
 use crate::data::ReChoice;
 use crate::diagnose::baseline::{fit_baseline, HELD_PRESSURE_KEYS};
 use crate::diagnose::case::{Case, Outcome};
-use crate::diagnose::sensor_zero::ZeroFinding;
 use crate::diagnose::{html, plots};
 use crate::fit::Progress;
 use crate::{Error, Result};
@@ -86,8 +85,6 @@ pub fn run(a: Args) -> Result<()> {
     inputs.extend(a.tir.iter().cloned());
     let mut prov = crate::tir::provenance::Provenance::of_inputs(&inputs)?;
     std::fs::create_dir_all(&a.report).map_err(|e| Error::io(&a.report, e))?;
-    // The sensor zeros found by the baseline fit (reported).
-    let mut sensor_zeros = None;
     let (case, note) = match (&a.tir, given) {
         (Some(tir), Some(t)) => (
             Case::given(t, recs),
@@ -159,11 +156,6 @@ pub fn run(a: Args) -> Result<()> {
                     fit.zeros.not_estimated.join("; ")
                 ));
             }
-            sensor_zeros = Some(ZeroFinding {
-                zeros: fit.zeros.clone(),
-                fit_gain: fit.zero_fit_gain,
-                removed: fit.zeroed.is_some(),
-            });
             (case, note)
         }
     };
@@ -200,7 +192,6 @@ pub fn run(a: Args) -> Result<()> {
         b.finish_and_clear();
     }
     report.baseline = Some(note.clone());
-    report.sensor_zeros = sensor_zeros;
     report.plots = serde_json::to_value(&pl).ok();
     let jp = a.report.join("diagnosis.json");
     let text = serde_json::to_string_pretty(&report)

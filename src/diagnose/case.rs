@@ -20,7 +20,9 @@
 use super::baseline::{drop_unfitted, Baseline};
 use super::reestimate::refit_fitted_baseline;
 use super::report::{diagnose_with, merge, Diagnosis};
-use super::sensor_zero::{extended_as_measured, for_diagnosis, AsMeasured, ForDiagnosis};
+use super::sensor_zero::{
+    extended_as_measured, for_diagnosis, AsMeasured, ForDiagnosis, ZeroFinding,
+};
 use crate::data::Recording;
 use crate::error::Result;
 use crate::mf::Tyre;
@@ -36,6 +38,9 @@ pub struct Case {
     /// measured.
     baseline_file: TyreParams,
     for_d: ForDiagnosis,
+    /// The sensor zeros the fit found (`None` for a given tyre): the
+    /// report's `sensor_zeros`.
+    zeros: Option<ZeroFinding>,
     /// Channels not diagnosed at all: the fit had no segments for them
     /// ([`drop_unfitted`]).
     pub dropped: Vec<&'static str>,
@@ -60,6 +65,7 @@ impl Case {
             baseline_file: tyre.params().clone(),
             compared: tyre,
             for_d: for_diagnosis(None, merge(recs), None),
+            zeros: None,
             dropped: Vec::new(),
         }
     }
@@ -75,6 +81,7 @@ impl Case {
             compared: Tyre::new(b.compared().clone())?,
             baseline_file: b.tyre.clone(),
             for_d: for_diagnosis(Some(b), merge(recs), fitted_on),
+            zeros: Some(ZeroFinding::of(b)),
             dropped,
         })
     }
@@ -96,7 +103,8 @@ impl Case {
         self.for_d.measured.as_ref()
     }
 
-    /// Diagnose, and build the files. `threads` for the re-estimation's
+    /// Diagnose, and build the files; the report carries the sensor zeros
+    /// the fit found (`sensor_zeros`). `threads` for the re-estimation's
     /// fits; `step` is told each stage's name (progress).
     pub fn diagnose(&self, threads: usize, step: &mut dyn FnMut(&str)) -> Result<Outcome> {
         let refit = refit_fitted_baseline(threads);
@@ -111,6 +119,8 @@ impl Case {
             Some(m) => extended_as_measured(&mut d, &self.compared, m, &refit, step)?,
             None => d.extended.params().clone(),
         };
+        d.report.sensor_zeros = self.zeros.clone();
+        d.json = d.report.to_json();
         Ok(Outcome {
             diagnosis: d,
             baseline_file: self.baseline_file.clone(),

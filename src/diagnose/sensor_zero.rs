@@ -126,6 +126,17 @@ pub struct ZeroFinding {
     pub removed: bool,
 }
 
+impl ZeroFinding {
+    /// What the baseline fit `b` found and did with the zeros.
+    pub fn of(b: &Baseline) -> Self {
+        Self {
+            zeros: b.zeros.clone(),
+            fit_gain: b.zero_fit_gain,
+            removed: b.zeroed.is_some(),
+        }
+    }
+}
+
 impl SensorZeros {
     /// The zero of `ch` (`None` for a channel without an estimate or one
     /// this module does not treat).

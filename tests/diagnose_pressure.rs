@@ -170,7 +170,7 @@ fn opts() -> ReplayOptions {
 
 /// The pressure candidate's fitted parameter `k` of a diagnosis.
 fn fitted(d: &tyrekit::diagnose::report::Diagnosis, k: &str) -> f64 {
-    d.json["effects"]
+    d.json()["effects"]
         .as_array()
         .unwrap()
         .iter()
@@ -181,7 +181,7 @@ fn fitted(d: &tyrekit::diagnose::report::Diagnosis, k: &str) -> f64 {
 
 fn show(d: &tyrekit::diagnose::report::Diagnosis) {
     println!("verdict {}: {}", d.verdict, d.explanation);
-    for e in d.json["effects"].as_array().unwrap() {
+    for e in d.json()["effects"].as_array().unwrap() {
         println!(
             "  {:<18} gain {:+.3} dBIC {:+.1} {} {}",
             e["name"].as_str().unwrap_or(""),

@@ -119,7 +119,7 @@ fn opts(tyre: &Tyre) -> ReplayOptions {
 
 /// The fitted speed_friction entry of a diagnosis, printed.
 fn speed_entry(d: &tyrekit::diagnose::report::Diagnosis) -> serde_json::Value {
-    for e in d.json["effects"].as_array().unwrap() {
+    for e in d.json()["effects"].as_array().unwrap() {
         println!(
             "  {:18} gain {:+.3} ΔBIC {:+.0}",
             e["name"].as_str().unwrap(),
@@ -127,7 +127,7 @@ fn speed_entry(d: &tyrekit::diagnose::report::Diagnosis) -> serde_json::Value {
             e["delta_bic"].as_f64().unwrap()
         );
     }
-    let e = d.json["effects"]
+    let e = d.json()["effects"]
         .as_array()
         .unwrap()
         .iter()

@@ -101,7 +101,8 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
     std::fs::write(dir.join("report.html"), page).map_err(|e| crate::Error::io(&dir, e))?;
     let t_plot = t0.elapsed().as_secs_f64();
     let total = t_all.elapsed().as_secs_f64();
-    let names: Vec<&str> = d.json["candidates_implemented"]
+    let json = d.json();
+    let names: Vec<&str> = json["candidates_implemented"]
         .as_array()
         .map(|a| a.iter().filter_map(|v| v.as_str()).collect())
         .unwrap_or_default();

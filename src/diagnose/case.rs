@@ -120,7 +120,6 @@ impl Case {
             None => d.extended.params().clone(),
         };
         d.report.sensor_zeros = self.zeros.clone();
-        d.json = d.report.to_json();
         Ok(Outcome {
             diagnosis: d,
             baseline_file: self.baseline_file.clone(),

@@ -211,10 +211,8 @@ impl DiagnosisReport {
 /// The diagnosis: its report, the chosen extended tyre and the series the
 /// plots need.
 pub struct Diagnosis {
-    /// The report ([`DiagnosisReport`]).
+    /// The report ([`DiagnosisReport`]; as JSON: [`Diagnosis::json`]).
     pub report: DiagnosisReport,
-    /// The same as JSON.
-    pub json: Value,
     pub verdict: String,
     /// The verdict is the slip channel's rolling-radius finding
     /// ([`slip_channel`]), not a force candidate's.
@@ -231,6 +229,15 @@ pub struct Diagnosis {
     /// The quality rows: in-sample, out-of-sample.
     pub in_sample: Vec<QualityRow>,
     pub out_of_sample: Vec<QualityRow>,
+}
+
+impl Diagnosis {
+    /// The report as JSON (`diagnosis.json` before the command adds the
+    /// baseline note and the plots), derived from [`Diagnosis::report`]
+    /// each time, so that it cannot fall behind a change of the report.
+    pub fn json(&self) -> Value {
+        self.report.to_json()
+    }
 }
 
 /// Run the diagnosis of `rec` against the baseline `tyre`.
@@ -511,7 +518,6 @@ pub fn diagnose_with(
         plots: None,
     };
     Ok(Diagnosis {
-        json: report.to_json(),
         report,
         verdict,
         by_slip: slip_verdict,

@@ -421,7 +421,6 @@ pub fn extended_as_measured(
     ));
     d.explanation.push_str(&w);
     d.report.explanation.push_str(&w);
-    d.json = d.report.to_json();
     Ok(file.map_or(fallback, |t| t.params().clone()))
 }
 

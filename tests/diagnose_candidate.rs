@@ -37,7 +37,7 @@ fn relaxation_is_named_on_lagged_truth_and_none_on_control() {
         "FY locate: {}",
         serde_json::to_string(&d.json()["locate"]["FY"][0]).unwrap()
     );
-    assert_eq!(d.verdict, "relaxation");
+    assert_eq!(d.verdict(), "relaxation");
     assert_eq!(d.json()["effects"][0]["name"], "relaxation");
     // Held-out gain: the truth lags the slips, the candidate the contact
     // deflections (another formulation), so not all of it goes; measured
@@ -59,7 +59,7 @@ fn relaxation_is_named_on_lagged_truth_and_none_on_control() {
         "{}",
         serde_json::to_string_pretty(&c.json()["effects"]).unwrap()
     );
-    assert_eq!(c.verdict, "none");
+    assert_eq!(c.verdict(), "none");
     let c_json = c.json();
     let rel = c_json["effects"]
         .as_array()

@@ -36,8 +36,13 @@ fn check(kind: ScalingKind, a: f64, s_of: impl Fn(f64) -> f64, seed: u64) {
     let mut m = Scaling::new(tyre.clone(), kind, a);
     let rec = recording(&tyre, &mut m, seed);
     let d = diagnose(&rec, &tyre, &common::diagnose_opts()).unwrap();
-    println!("{kind:?}: {}", d.explanation);
-    assert_eq!(d.verdict, "load_sensitivity", "{kind:?}: {}", d.explanation);
+    println!("{kind:?}: {}", d.explanation());
+    assert_eq!(
+        d.verdict(),
+        "load_sensitivity",
+        "{kind:?}: {}",
+        d.explanation()
+    );
     let fnom = tyre.params().p.fnomin;
     let p = d.extended.params();
     let mut n = 0;
@@ -86,5 +91,5 @@ fn control_stays_none() {
     let mut m = SteadyMf::new(tyre.clone());
     let rec = recording(&tyre, &mut m, 33);
     let d = diagnose(&rec, &tyre, &common::diagnose_opts()).unwrap();
-    assert_eq!(d.verdict, "none", "{}", d.explanation);
+    assert_eq!(d.verdict(), "none", "{}", d.explanation());
 }

@@ -180,7 +180,7 @@ fn fitted(d: &tyrekit::diagnose::report::Diagnosis, k: &str) -> f64 {
 }
 
 fn show(d: &tyrekit::diagnose::report::Diagnosis) {
-    println!("verdict {}: {}", d.verdict, d.explanation);
+    println!("verdict {}: {}", d.verdict(), d.explanation());
     for e in d.json()["effects"].as_array().unwrap() {
         println!(
             "  {:<18} gain {:+.3} dBIC {:+.1} {} {}",
@@ -210,7 +210,7 @@ fn stiffness_law_is_named_pressure_with_stiffness_terms() {
     let rec = recording(&tyre, Law::Stiffness);
     let d = diagnose(&rec, &tyre, &opts()).unwrap();
     show(&d);
-    assert_eq!(d.verdict, "pressure");
+    assert_eq!(d.verdict(), "pressure");
     // The law adds A to the stiffness terms of the file (Kyα, Kxκ ∝
     // (1 + PP?1·dpi)) in pure slip; it also scales combined slips and
     // stretches Mz's trail curve, which the MF's terms do not, so the fit
@@ -236,7 +236,7 @@ fn friction_law_is_named_pressure_with_friction_terms() {
     let rec = recording(&tyre, Law::Friction);
     let d = diagnose(&rec, &tyre, &opts()).unwrap();
     show(&d);
-    assert_eq!(d.verdict, "pressure");
+    assert_eq!(d.verdict(), "pressure");
     // μ ∝ (1 + PP?3·dpi) against s = 1 − A·dp: −A on top of the file's
     // value; between −1.5·A and −A/4 as for the stiffness law.
     for k in ["PPY3", "PPX3"] {
@@ -264,7 +264,7 @@ fn drifting_pressure_without_a_law_is_none() {
     let tyre = Tyre::builtin();
     let d = diagnose(&recording(&tyre, Law::None), &tyre, &opts()).unwrap();
     show(&d);
-    assert_eq!(d.verdict, "none");
+    assert_eq!(d.verdict(), "none");
 }
 
 /// Each channel's BIC charges the pressure terms that can move it
@@ -359,11 +359,11 @@ fn heating_with_gas_law_pressure(level: f64) -> tyrekit::diagnose::report::Diagn
 fn a_pressure_that_follows_the_tread_temperature_does_not_turn_heating_into_pressure() {
     for level in [1.0, 0.3] {
         let d = heating_with_gas_law_pressure(level);
-        assert_eq!(d.verdict, "thermal", "level {level}: {}", d.explanation);
+        assert_eq!(d.verdict(), "thermal", "level {level}: {}", d.explanation());
         assert!(
             d.report.also_qualifying.iter().any(|c| c == "pressure"),
             "level {level}: pressure not reported beside thermal: {}",
-            d.explanation
+            d.explanation()
         );
     }
 }

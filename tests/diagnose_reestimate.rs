@@ -129,11 +129,12 @@ fn refitting_the_baseline_beneath_the_extension_comes_nearer_the_truth() {
     );
     // The re-estimation shapes extended.tir only: same verdict, same scores.
     assert_eq!(
-        c.plain.verdict, "load_sensitivity",
+        c.plain.verdict(),
+        "load_sensitivity",
         "{}",
-        c.plain.explanation
+        c.plain.explanation()
     );
-    assert_eq!(c.re.verdict, c.plain.verdict);
+    assert_eq!(c.re.verdict(), c.plain.verdict());
     assert_eq!(
         c.re.report.effects[0].score, c.plain.report.effects[0].score,
         "the held-out scores are the unchanged baseline's"
@@ -147,7 +148,7 @@ fn refitting_the_baseline_beneath_the_extension_comes_nearer_the_truth() {
     println!(
         "Fy RMS against the truth: baseline {e_base:.1} N, extension on it {e_plain:.1} N, re-estimated ({rounds} rounds) {e_re:.1} N"
     );
-    assert!(rounds >= 1, "no round kept: {}", c.re.explanation);
+    assert!(rounds >= 1, "no round kept: {}", c.re.explanation());
     assert!(e_plain < e_base, "the extension alone must help");
     // Measured 10.2 N against 35.6 N (0.29×): the sensor noise (12 N) on
     // thousands of samples leaves the joint fit a few newtons from the
@@ -173,8 +174,8 @@ fn refitting_beneath_a_pressure_law_at_the_recorded_pressures_comes_nearer_the_t
         false,
         43,
     );
-    assert_eq!(c.plain.verdict, "pressure", "{}", c.plain.explanation);
-    assert_eq!(c.re.verdict, c.plain.verdict);
+    assert_eq!(c.plain.verdict(), "pressure", "{}", c.plain.explanation());
+    assert_eq!(c.re.verdict(), c.plain.verdict());
     let rounds = c.rounds();
     let fy = |t: &Tyre| lateral_error(&c.rec, &c.truth, t, |s| s.fy, |f| f.fy);
     let mz = |t: &Tyre| lateral_error(&c.rec, &c.truth, t, |s| s.mz, |f| f.mz);
@@ -191,7 +192,7 @@ fn refitting_beneath_a_pressure_law_at_the_recorded_pressures_comes_nearer_the_t
             "{k} is not a term the candidate fits"
         );
     }
-    assert!(rounds >= 1, "no round kept: {}", c.re.explanation);
+    assert!(rounds >= 1, "no round kept: {}", c.re.explanation());
     assert!(fy_plain < fy_base, "the extension alone must help");
     // Measured Fy 41.4 N against 51.4 N (0.81×), Mz 10.52 against 10.88 N·m
     // (0.97×): the MF's pressure terms cannot make the similarity form's
@@ -259,8 +260,8 @@ fn refitting_beneath_a_rolling_radius_finding_comes_nearer_the_truth_from_the_wh
     let path = dir.join("constant_radius_sr.dat");
     run.write_dat(&path).unwrap();
     let (rec, base, plain, re) = fitted_and_diagnosed(Recording::from_file(&path).unwrap());
-    assert_eq!(plain.verdict, "rolling_radius", "{}", plain.explanation);
-    assert_eq!(re.verdict, plain.verdict);
+    assert_eq!(plain.verdict(), "rolling_radius", "{}", plain.explanation());
+    assert_eq!(re.verdict(), plain.verdict());
     // The noise-free truth of each row read (matched by time), against the
     // replay with κ from the wheel speed, over every segment.
     let truth: std::collections::HashMap<i64, Sample> = run
@@ -398,7 +399,7 @@ fn with_sensor_zeros_the_file_built_as_measured_comes_nearer_the_truth() {
     assert_eq!(compared.params().p.as_slice(), b.compared().p.as_slice());
     let out = prepared.diagnose(2, &mut |_| {}).unwrap();
     let (d, ext) = (out.diagnosis, out.extended_file);
-    assert_eq!(d.verdict, "load_sensitivity", "{}", d.explanation);
+    assert_eq!(d.verdict(), "load_sensitivity", "{}", d.explanation());
     // The report says which zeros were found and that they were removed.
     let z = d
         .report
@@ -414,7 +415,11 @@ fn with_sensor_zeros_the_file_built_as_measured_comes_nearer_the_truth() {
         .baseline_reestimated
         .as_ref()
         .map_or(0, |r| r.rounds);
-    assert!(rounds >= 1, "no round kept for the file: {}", d.explanation);
+    assert!(
+        rounds >= 1,
+        "no round kept for the file: {}",
+        d.explanation()
+    );
     let mixed = as_measured(d.extended.params(), compared.params(), &b.tyre);
     let (e_base, e_ext, e_mixed) = (
         fy_error(raw, &truth, &Tyre::new(b.tyre.clone()).unwrap()),

@@ -26,7 +26,7 @@ fn the_extended_file_is_the_verdict_refitted_on_both_halves() {
     let opts = common::diagnose_opts();
 
     let d = diagnose(&rec, &tyre, &opts).unwrap();
-    assert_eq!(d.verdict, "load_sensitivity", "{}", d.explanation);
+    assert_eq!(d.verdict(), "load_sensitivity", "{}", d.explanation());
 
     // The report names what the file holds.
     let written = d

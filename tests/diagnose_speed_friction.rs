@@ -148,9 +148,9 @@ fn speed_friction_is_named_on_two_formulations_and_none_on_the_control() {
     // recorded 0–3 m/s, so most of it must go (half is the floor that
     // still means "the law was found", the selection's own bar is 5 %).
     let d = diagnose(&recording(&tyre, linear, "linear"), &tyre, &opts(&tyre)).unwrap();
-    println!("linear: {}", d.verdict);
+    println!("linear: {}", d.verdict());
     let e = speed_entry(&d);
-    assert_eq!(d.verdict, "speed_friction");
+    assert_eq!(d.verdict(), "speed_friction");
     assert!(e["score"].as_f64().unwrap() > 0.5, "{}", e["score"]);
     // The truth's fall is against the baseline's own friction: the fit
     // must keep the reference at (or near) zero sliding speed — a VREF
@@ -169,9 +169,9 @@ fn speed_friction_is_named_on_two_formulations_and_none_on_the_control() {
         &opts(&tyre),
     )
     .unwrap();
-    println!("exponential: {}", d.verdict);
+    println!("exponential: {}", d.verdict());
     let e = speed_entry(&d);
-    assert_eq!(d.verdict, "speed_friction");
+    assert_eq!(d.verdict(), "speed_friction");
     assert!(e["score"].as_f64().unwrap() > 0.25, "{}", e["score"]);
     let vref = e["parameters"]["VREF"].as_f64().unwrap();
     assert!(
@@ -183,8 +183,8 @@ fn speed_friction_is_named_on_two_formulations_and_none_on_the_control() {
     // the law removes (almost) nothing — 1 % is noise-fitting room for
     // three parameters on held-out data.
     let d = diagnose(&recording(&tyre, plain, "control"), &tyre, &opts(&tyre)).unwrap();
-    println!("control: {}", d.verdict);
+    println!("control: {}", d.verdict());
     let e = speed_entry(&d);
-    assert_eq!(d.verdict, "none");
+    assert_eq!(d.verdict(), "none");
     assert!(e["score"].as_f64().unwrap() < 0.01, "{}", e["score"]);
 }

@@ -109,7 +109,7 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
     println!(
         "[diagnose] diagnosis (candidates {}) {t_diag:8.3} s; plots + page {t_plot:.3} s; verdict {}",
         names.join(", "),
-        d.verdict
+        d.verdict()
     );
     println!(
         "[diagnose] total without --tir {total:8.3} s = {:.1} s per 150 000 samples (goal ≤ 60 s); with --tir (no fit) {:.1} s per 150 000",

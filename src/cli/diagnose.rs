@@ -184,7 +184,8 @@ pub fn run(a: Args) -> Result<()> {
     let mut report = d.report.clone();
     prov.stamp(&mut base);
     base.write(&a.report.join("baseline.tir"))?;
-    prov.lines.push(format!("diagnosis verdict: {}", d.verdict));
+    prov.lines
+        .push(format!("diagnosis verdict: {}", d.verdict()));
     prov.stamp(&mut ext);
     ext.write(&a.report.join("extended.tir"))?;
     let pl = plots::draw_all(rec, &d, &a.report)?;
@@ -203,8 +204,8 @@ pub fn run(a: Args) -> Result<()> {
     json["report_html"] = serde_json::to_value(a.report.join("report.html")).unwrap_or_default();
     let hp = a.report.join("report.html");
     std::fs::write(&hp, html::page(&d, &pl, &rec.source, &note)).map_err(|e| Error::io(&hp, e))?;
-    m.say(format_args!("verdict: {}", d.verdict));
-    m.say(&d.explanation);
+    m.say(format_args!("verdict: {}", d.verdict()));
+    m.say(d.explanation());
     for r in d.out_of_sample.iter().filter(|r| r.condition == "all") {
         m.say(format_args!(
             "  held out {}: σ {:.2} % -> {:.2} %, NRMSE {:.2} % -> {:.2} %",
@@ -218,7 +219,7 @@ pub fn run(a: Args) -> Result<()> {
     if let Some(w) = d.report.extended_parameters_in_words() {
         m.say(format_args!(
             "  extended.tir: {} refitted on every segment (the held-out figures above are the half fit's): {w}",
-            d.verdict
+            d.verdict()
         ));
     }
     m.say(format_args!(

@@ -87,9 +87,9 @@ tr.sig{{background:#fff4e0}} td.good{{color:#080}} figure{{margin:1.5em 0}} img{
 figcaption{{font-size:.9em;color:#444}} details{{margin:1em 0}}\
 </style></head><body>\n<h1>Diagnosis of {src}</h1>\n\
 <p class=\"verdict\">Verdict: <b>{v}</b></p>\n<p>{ex}</p>\n<p><small>{bn}</small></p>\n",
-        v = esc(&d.verdict),
+        v = esc(d.verdict()),
         src = esc(source),
-        ex = esc(&d.explanation),
+        ex = esc(d.explanation()),
         bn = esc(baseline_note),
     );
     // Candidates.
@@ -153,7 +153,7 @@ figcaption{{font-size:.9em;color:#444}} details{{margin:1em 0}}\
         "<h2>Fit before and after</h2>\n<p>σ = √(Σ(sim − test)²/Σ test²), NRMSE = RMS(sim − test)/range(test); \
 before = baseline, after = {} model; each model's constant channel offset (sensor zero) estimated on the fit half and removed.</p>\n<h3>Out of sample (held-out segments)</h3>\n{}\
 <details><summary>In sample (segments the candidates were fitted on)</summary>\n{}</details>\n",
-        esc(&d.verdict),
+        esc(d.verdict()),
         quality_table(&d.out_of_sample),
         quality_table(&d.in_sample)
     );

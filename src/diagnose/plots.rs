@@ -254,13 +254,13 @@ pub fn draw_all(rec: &Recording, d: &Diagnosis, dir: &Path) -> Result<Vec<Plot>>
         if c.inside(10).is_empty() {
             continue;
         }
-        out.push(residual_slip(&c, &d.verdict, dir)?);
-        out.push(residual_load(&c, &d.verdict, dir)?);
-        out.push(hysteresis(&c, &d.verdict, dir)?);
-        out.push(drift(&c, &d.energy, &d.verdict, dir)?);
-        out.push(overlay(&c, &d.verdict, dir)?);
-        if d.verdict == "pressure" {
-            evidence.push(residual_pressure(&c, &d.verdict, dir)?);
+        out.push(residual_slip(&c, d.verdict(), dir)?);
+        out.push(residual_load(&c, d.verdict(), dir)?);
+        out.push(hysteresis(&c, d.verdict(), dir)?);
+        out.push(drift(&c, &d.energy, d.verdict(), dir)?);
+        out.push(overlay(&c, d.verdict(), dir)?);
+        if d.verdict() == "pressure" {
+            evidence.push(residual_pressure(&c, d.verdict(), dir)?);
         }
     }
     if let Some(sc) = d.report.slip_channel.as_ref().filter(|s| s.found) {

@@ -213,11 +213,9 @@ impl DiagnosisReport {
 pub struct Diagnosis {
     /// The report ([`DiagnosisReport`]; as JSON: [`Diagnosis::json`]).
     pub report: DiagnosisReport,
-    pub verdict: String,
     /// The verdict is the slip channel's rolling-radius finding
     /// ([`slip_channel`]), not a force candidate's.
     pub by_slip: bool,
-    pub explanation: String,
     pub extended: Tyre,
     /// Baseline and verdict's simulation, one per sample.
     pub baseline_sim: Vec<Forces>,
@@ -237,6 +235,14 @@ impl Diagnosis {
     /// each time, so that it cannot fall behind a change of the report.
     pub fn json(&self) -> Value {
         self.report.to_json()
+    }
+    /// The verdict: a candidate's name, `none` or `baseline misfit`.
+    pub fn verdict(&self) -> &str {
+        &self.report.verdict
+    }
+    /// The verdict and its evidence in words.
+    pub fn explanation(&self) -> &str {
+        &self.report.explanation
     }
 }
 
@@ -496,11 +502,11 @@ pub fn diagnose_with(
         .map(|r| r.parameters().into_iter().collect::<BTreeMap<_, _>>());
     let report = DiagnosisReport {
         verdict: verdict.clone(),
-        explanation: explanation.clone(),
+        explanation,
         also_qualifying: also.iter().map(|&i| ev[i].0.name.clone()).collect(),
         effects,
         quality: QualityReport {
-            model_after: verdict.clone(),
+            model_after: verdict,
             split: "candidates fitted on one half of the segments (in_sample), scored on the other (out_of_sample); halves alternate within each (kind, load) group",
             in_sample: in_sample.clone(),
             out_of_sample: out_of_sample.clone(),
@@ -519,9 +525,7 @@ pub fn diagnose_with(
     };
     Ok(Diagnosis {
         report,
-        verdict,
         by_slip: slip_verdict,
-        explanation,
         extended,
         baseline_sim: base.sim,
         extended_sim,

@@ -377,7 +377,7 @@ pub fn extended_as_measured(
     step: &mut dyn FnMut(&str),
 ) -> Result<TyreParams> {
     let fallback = as_measured(d.extended.params(), compared.params(), &m.tyre);
-    if d.verdict == "none" {
+    if d.verdict() == "none" {
         return Ok(fallback);
     }
     let tyre = Tyre::new(m.tyre.clone())?;
@@ -399,7 +399,7 @@ pub fn extended_as_measured(
         None if d.by_slip => None,
         None => owned
             .iter()
-            .find(|c| c.name() == d.verdict)
+            .find(|c| c.name() == d.verdict())
             .map(|c| FileOf::Candidate(c.as_ref())),
     };
     let built = of.map(|of| build_extended(&m.rec, &tyre, &opts, of, refit, step));
@@ -419,7 +419,6 @@ pub fn extended_as_measured(
     let w = words.unwrap_or_else(|why| format!(
         " extended.tir could not be built again on the recording as measured ({why}): it holds the extension found without the sensor zeros, with the first fit's values under the keys the diagnosis left alone."
     ));
-    d.explanation.push_str(&w);
     d.report.explanation.push_str(&w);
     Ok(file.map_or(fallback, |t| t.params().clone()))
 }

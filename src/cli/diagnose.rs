@@ -206,7 +206,13 @@ pub fn run(a: Args) -> Result<()> {
     std::fs::write(&hp, html::page(&d, &pl, &rec.source, &note)).map_err(|e| Error::io(&hp, e))?;
     m.say(format_args!("verdict: {}", d.verdict()));
     m.say(d.explanation());
-    for r in d.out_of_sample.iter().filter(|r| r.condition == "all") {
+    for r in d
+        .report
+        .quality
+        .out_of_sample
+        .iter()
+        .filter(|r| r.condition == "all")
+    {
         m.say(format_args!(
             "  held out {}: σ {:.2} % -> {:.2} %, NRMSE {:.2} % -> {:.2} %",
             r.channel.name(),

@@ -154,8 +154,8 @@ figcaption{{font-size:.9em;color:#444}} details{{margin:1em 0}}\
 before = baseline, after = {} model; each model's constant channel offset (sensor zero) estimated on the fit half and removed.</p>\n<h3>Out of sample (held-out segments)</h3>\n{}\
 <details><summary>In sample (segments the candidates were fitted on)</summary>\n{}</details>\n",
         esc(d.verdict()),
-        quality_table(&d.out_of_sample),
-        quality_table(&d.in_sample)
+        quality_table(&d.report.quality.out_of_sample),
+        quality_table(&d.report.quality.in_sample)
     );
     // Plots.
     s.push_str("<h2>Plots</h2>\n");

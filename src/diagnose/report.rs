@@ -224,9 +224,6 @@ pub struct Diagnosis {
     pub findings: Vec<(Channel, Vec<Finding>)>,
     /// Accumulated frictional energy per sample (J).
     pub energy: Vec<f64>,
-    /// The quality rows: in-sample, out-of-sample.
-    pub in_sample: Vec<QualityRow>,
-    pub out_of_sample: Vec<QualityRow>,
 }
 
 impl Diagnosis {
@@ -508,8 +505,8 @@ pub fn diagnose_with(
         quality: QualityReport {
             model_after: verdict,
             split: "candidates fitted on one half of the segments (in_sample), scored on the other (out_of_sample); halves alternate within each (kind, load) group",
-            in_sample: in_sample.clone(),
-            out_of_sample: out_of_sample.clone(),
+            in_sample,
+            out_of_sample,
         },
         locate,
         candidates_implemented: owned.iter().map(|c| c.name()).collect(),
@@ -531,8 +528,6 @@ pub fn diagnose_with(
         extended_sim,
         findings,
         energy,
-        in_sample,
-        out_of_sample,
     })
 }
 

@@ -392,15 +392,21 @@ fn variant_verdicts(
     use std::io::Write;
     devset::run_all(test, |a, work, data| {
         let path = work.join(format!("{}.dat", a.name));
-        let lines = devset::read_lines(&a.file);
+        let lines = rewrite(&a.name, devset::read_lines(&a.file));
+        // A rewrite that keeps no data row: the recording has nothing of
+        // the variation (a drive/brake cut of a cornering-only programme).
+        if lines.len() <= 2 {
+            return None;
+        }
         let mut out = std::io::BufWriter::new(std::fs::File::create(&path).expect("variant"));
-        for l in rewrite(&a.name, lines) {
+        for l in lines {
             writeln!(out, "{l}").expect("write");
         }
         drop(out);
         let verdict = diagnose_cli(&a.name, &path, &work.join(&a.name));
-        (a.name.clone(), answer_of(data, &a.name).0, verdict)
+        Some((a.name.clone(), answer_of(data, &a.name).0, verdict))
     })
+    .map(|v| v.into_iter().flatten().collect())
 }
 
 /// The lines with only the data rows `keep(row, rows)` keeps (names and
@@ -422,7 +428,10 @@ fn keep_rows(lines: Vec<String>, keep: impl Fn(usize, usize) -> bool) -> Vec<Str
 /// (`diagnose::candidate::DECORRELATION_TIME`), so the same effects must be
 /// named and the controls stay `none`: the level of the 100 Hz guard
 /// (measured 28 Nov 2026: all 21 verdicts as at 100 Hz, 161 s).
+/// On demand since 29 Nov 2026 (it passed unchanged in every run since 28
+/// Nov; the drive/brake variation took its place in CI's hour).
 #[test]
+#[ignore = "on demand (≈ 160 s): the 50 Hz variation; CI runs the drive/brake variation in its place"]
 fn devset_verdicts_hold_at_half_the_sample_rate() {
     let Some(v) = variant_verdicts("diagnose_devset_50hz", |_, l| {
         keep_rows(l, |i, _| i % 2 == 0)
@@ -451,6 +460,81 @@ fn devset_shortened_programmes_name_no_wrong_effect() {
         return;
     };
     no_wrong_name(&v, "cut after 85 %", SHORTENED_NAMED_BEFORE);
+}
+
+/// A drive/brake run names no wrong effect: every recording cut to its
+/// pure and combined drive/brake blocks (the rows within 3 s of a slip ratio
+/// above 3 %; the cornering sweeps and the warm-up gone, the recorded
+/// times kept), as a TTC drive/brake run file comes without cornering
+/// sweeps; the three cornering-only programmes have no such rows and are
+/// left out. The baseline then fits the combined-slip Fy and Mz at 7–17×
+/// the noise floor, and a gain there is no evidence
+/// (`ChannelScore::baseline_misfit`); the rolling radius is read where
+/// the sweeps' Fx crosses zero (`diagnose::slip_channel`). Measured 29 Nov
+/// 2026: 9 of 15 named (r02, r05, r07, r10, r12, r13, r17, r18, r19),
+/// controls `none`, none wrong (166 s); before those two rules r04
+/// (pressure) and r18 (relaxation) were named `lugre` on Fy gains the
+/// baseline's misfit offered, and r02, r07, r10 (rolling radius) `none`,
+/// `none` and `speed_friction`.
+#[test]
+fn devset_drive_brake_runs_name_no_wrong_effect() {
+    let Some(v) = variant_verdicts("diagnose_devset_drive_brake", drive_brake_only) else {
+        return;
+    };
+    no_wrong_name(&v, "drive/brake only", NAMED_BEFORE);
+    let named = v.iter().filter(|(_, e, x)| e != "none" && e == x).count();
+    assert!(
+        named >= DRIVE_BRAKE_NAMED_BEFORE,
+        "named first drive/brake only: {named}, before {DRIVE_BRAKE_NAMED_BEFORE}"
+    );
+}
+
+/// Effects named first on the drive/brake variation (29 Nov 2026).
+const DRIVE_BRAKE_NAMED_BEFORE: usize = 9;
+
+/// The lines with only the rows within 3 s (300 rows at the dev set's
+/// 100 Hz) of a slip ratio |SR| > 3 %; only the header when fewer than 5 %
+/// of the rows are left.
+fn drive_brake_only(_: &str, lines: Vec<String>) -> Vec<String> {
+    let col = lines[0]
+        .split('\t')
+        .position(|c| c.trim() == "SR")
+        .expect("an SR column");
+    let sliding: Vec<bool> = lines[2..]
+        .iter()
+        .map(|l| {
+            l.split('\t')
+                .nth(col)
+                .and_then(|x| x.trim().parse::<f64>().ok())
+                .is_some_and(|x| x.abs() > 0.03)
+        })
+        .collect();
+    // Rows since the last / until the next sliding row.
+    let n = sliding.len();
+    let (mut before, mut after) = (vec![usize::MAX; n], vec![usize::MAX; n]);
+    for i in 0..n {
+        before[i] = if sliding[i] {
+            0
+        } else if i > 0 {
+            before[i - 1].saturating_add(1)
+        } else {
+            usize::MAX
+        };
+    }
+    for i in (0..n).rev() {
+        after[i] = if sliding[i] {
+            0
+        } else if i + 1 < n {
+            after[i + 1].saturating_add(1)
+        } else {
+            usize::MAX
+        };
+    }
+    let keep: Vec<bool> = (0..n).map(|i| before[i].min(after[i]) <= 300).collect();
+    if 20 * keep.iter().filter(|k| **k).count() < n {
+        return lines.into_iter().take(2).collect();
+    }
+    keep_rows(lines, |i, _| keep[i])
 }
 
 /// Another rig's sensors: every recording with its force and load channels'

@@ -48,7 +48,9 @@ use std::ops::Range;
 
 use super::explain::at_bound_note;
 pub use super::explain::{caution, explain, findings_in_words, WORSE};
-pub use super::misfit::{baseline_fit, misfit_note, BaselineFit, MISFIT_RATIO};
+pub use super::misfit::{
+    baseline_fit, excess_removed, misfit_note, BaselineFit, MISFIT_EXPLAINED, MISFIT_RATIO,
+};
 pub use super::quality::{
     channel_present, channel_series, quality, split, QualityReport, QualityRow,
 };
@@ -233,7 +235,8 @@ impl Diagnosis {
     pub fn json(&self) -> Value {
         self.report.to_json()
     }
-    /// The verdict: a candidate's name, `none` or `baseline misfit`.
+    /// The verdict: a candidate's name or `none` (the explanation then
+    /// says why: nothing missing, or the baseline's own misfit).
     pub fn verdict(&self) -> &str {
         &self.report.verdict
     }
@@ -291,14 +294,52 @@ pub fn diagnose_with(
     });
     let findings =
         findings.map_err(|_| crate::Error::Other("diagnose: the locate thread failed".into()))?;
-    let ev = ev?;
+    let mut ev = ev?;
     step("report");
-    let verdict_i = select(&ev);
+    // The baseline against the noise floor, before any verdict: a channel
+    // the baseline itself misfits carries a candidate's evidence only when
+    // the candidate takes most of the misfit away (MISFIT_EXPLAINED).
+    let (fit_r, test_r) = split(rec);
+    let mask = |rs: &[Range<usize>]| {
+        let mut m = vec![false; rec.samples.len()];
+        for r in rs {
+            m[r.clone()].iter_mut().for_each(|x| *x = true);
+        }
+        m
+    };
+    let test_mask = mask(&test_r);
+    let fit_mask = mask(&fit_r);
+    let base_fit = baseline_fit(rec, &base.sim, &fit_mask, &test_mask);
     // The slip channel against the free-rolling radius: a rolling-radius
     // finding the force residuals cannot make (see [`slip_channel`]). It
     // names the verdict when no force candidate qualifies, and is added to
-    // the explanation otherwise.
+    // the explanation otherwise. With a radius error, Fx is read at a slip
+    // off by a load-dependent K_x·ΔSR of more than `FORCE_SHARE` of Fz
+    // (the baseline's horizontal shift takes up only its linear part): no
+    // evidence for another effect.
     let mut slip = slip_channel::check(rec, tyre);
+    let slip_found = slip.as_ref().is_some_and(|s| s.found);
+    for (e, _) in ev.iter_mut() {
+        for c in e.channels.iter_mut() {
+            let ratio = base_fit
+                .iter()
+                .find(|f| f.channel == c.channel)
+                .map_or(1.0, |f| f.ratio);
+            let removed = excess_removed(c.oos_gain, ratio);
+            c.baseline_misfit = if ratio > MISFIT_RATIO && removed < MISFIT_EXPLAINED {
+                Some(format!(
+                    "the baseline's held-out residual there stands at {ratio:.1}× the noise floor, and this candidate removes {:.0} % of what stands above the noise (at least {:.0} % for evidence)",
+                    100.0 * removed,
+                    100.0 * MISFIT_EXPLAINED
+                ))
+            } else if slip_found && c.channel == Channel::Fx {
+                Some("the recorded slip ratio was computed with a rolling radius that is not the tyre's (the slip-channel check), so Fx is read at the wrong slip".to_string())
+            } else {
+                None
+            };
+        }
+    }
+    let verdict_i = select(&ev);
     let slip_ext = match slip.as_ref().filter(|s| s.found) {
         Some(s) => Some(s.extended(tyre)?),
         None => None,
@@ -334,15 +375,6 @@ pub fn diagnose_with(
     } else {
         verdict_i.map_or("none".to_string(), |i| ev[i].0.name.clone())
     };
-    let (fit_r, test_r) = split(rec);
-    let mask = |rs: &[Range<usize>]| {
-        let mut m = vec![false; rec.samples.len()];
-        for r in rs {
-            m[r.clone()].iter_mut().for_each(|x| *x = true);
-        }
-        m
-    };
-    let test_mask = mask(&test_r);
     let mut effects = Vec::new();
     let mut order: Vec<usize> = (0..ev.len()).collect();
     order.sort_by_key(|&i| usize::from(ev[i].0.name != verdict));
@@ -407,8 +439,6 @@ pub fn diagnose_with(
     let alpha = LocateOptions::default().alpha;
     let in_sample = quality(rec, &base.sim, &extended_sim, &fit_r, &fit_r)?;
     let out_of_sample = quality(rec, &base.sim, &extended_sim, &fit_r, &test_r)?;
-    let fit_mask = mask(&fit_r);
-    let base_fit = baseline_fit(rec, &base.sim, &fit_mask, &test_mask);
     let mut explanation = explain(&findings, verdict_i.map(|i| &ev[i].0), best_other, alpha);
     // A qualifier another candidate overshadows is not named: say which, and why.
     if let Some(w) = overshadowed_summary(&ev) {

@@ -9,7 +9,9 @@
 //! §2.2 and §9.2.1). On the pure lateral sweeps (no drive or brake torque),
 //! at |α| < 1°, SR therefore reads Re_R/Re − 1 ≈ (R − Re)/Re: constant over
 //! the loads when R follows the tyre's radius (a constant offset is a zero
-//! error of the rig), and varying with load when it does not.
+//! error of the rig), and varying with load when it does not. A drive/brake
+//! run has no such sweeps; there free rolling is where a sweep's Fx crosses
+//! zero, and SR there reads the same (see [`check`]).
 //!
 //! Read as slip by a model, that load-dependent SR is a longitudinal force
 //! error of K_x(Fz)·ΔSR (K_x the slip stiffness). A Magic Formula fit hides
@@ -26,9 +28,10 @@
 //! takes away, so that the FMU fed the wheel speed gives the slip the tyre
 //! sees and the forces the fit found.
 //!
-//! Must never: use samples under drive or brake torque (only pure lateral
-//! sweeps), judge a recording with fewer than [`MIN_LEVELS`] load levels, or
-//! call a constant SR offset a radius.
+//! Must never: read a radius from samples under drive or brake torque (the
+//! pure lateral sweeps; without enough of them only the zero-Fx point of
+//! the drive/brake sweeps), judge a recording with fewer than
+//! [`MIN_LEVELS`] load levels, or call a constant SR offset a radius.
 
 use crate::data::{Recording, SegmentKind};
 use crate::error::Result;
@@ -81,6 +84,13 @@ pub struct Level {
 /// The slip channel against the free-rolling radius (see the module docs).
 #[derive(Clone, Debug, Serialize)]
 pub struct SlipChannel {
+    /// Where free rolling was read: "pure lateral sweeps, |α| < 1°" or, in a
+    /// recording without enough of them, "zero-Fx crossings of the drive/brake
+    /// sweeps, |α| < 1°".
+    pub from: &'static str,
+    /// The Fx sensor zero error fitted out of a drive/brake read (N; None
+    /// on the lateral sweeps, which do not read Fx) ([`check`]).
+    pub fx_zero: Option<f64>,
     pub levels: Vec<Level>,
     /// Largest minus smallest level SR.
     pub sr_span: f64,
@@ -92,7 +102,10 @@ pub struct SlipChannel {
 
 /// Compare the recorded slip ratio with the free-rolling radius; None when
 /// the recording has no SR channel, no wheel speed, or fewer than
-/// [`MIN_LEVELS`] load levels of free rolling.
+/// [`MIN_LEVELS`] load levels of free rolling. Free rolling is read on the
+/// pure lateral sweeps; a recording with fewer than [`MIN_LEVELS`] levels
+/// of them (a drive/brake run) is read at the zero-Fx crossings of its pure
+/// drive/brake sweeps instead ([`SlipChannel::from`] says which).
 pub fn check(rec: &Recording, tyre: &Tyre) -> Option<SlipChannel> {
     let sr = rec.extra("SR")?;
     if !rec.has("omega") {
@@ -104,85 +117,18 @@ pub fn check(rec: &Recording, tyre: &Tyre) -> Option<SlipChannel> {
         .filter(|s| s.fz.is_finite())
         .map(|s| s.fz)
         .fold(0.0, f64::max);
-    let lim = 1f64.to_radians();
-    // Load levels by the segments' load set points (within 5 % of the
-    // largest load), then (fz, sr, V/Ω, vx, Ω, p, γ) of their free-rolling
-    // samples.
-    let mut groups: Vec<(f64, Vec<[f64; 7]>)> = Vec::new();
-    for g in rec
-        .segments
-        .iter()
-        .filter(|g| g.kind == SegmentKind::PureLateral && g.fz.is_finite())
-    {
-        let k = match groups
-            .iter()
-            .position(|(f, _)| (f - g.fz).abs() < 0.05 * fmax)
-        {
-            Some(k) => k,
-            None => {
-                groups.push((g.fz, Vec::new()));
-                groups.len() - 1
-            }
-        };
-        for i in g.start..g.end.min(rec.samples.len()) {
-            let s = &rec.samples[i];
-            let r = sr.get(i).copied().unwrap_or(f64::NAN);
-            if s.alpha.abs() < lim
-                && s.fz > 0.1 * fmax
-                && s.omega > 1.0
-                && s.vx > 1.0
-                && r.is_finite()
-                && r.abs() < 0.1
-            {
-                groups[k]
-                    .1
-                    .push([s.fz, r, s.vx / s.omega, s.vx, s.omega, s.p, s.gamma]);
-            }
+    let mut levels = lateral_levels(rec, sr, fmax, tyre);
+    let mut from = "pure lateral sweeps, |α| < 1°";
+    let mut fx_zero = None;
+    if levels.len() < MIN_LEVELS {
+        levels = drive_brake_levels(rec, sr, fmax, tyre);
+        from = "zero-Fx crossings of the drive/brake sweeps, |α| < 1°";
+        // The Fx zero error is fitted beside the load law: one level more.
+        if levels.len() <= MIN_LEVELS || levels.iter().any(|l| !(l.kx > 0.0)) {
+            return None;
         }
+        fx_zero = Some(remove_fx_zero(&mut levels)?);
     }
-    groups.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let groups: Vec<Vec<[f64; 7]>> = groups.into_iter().map(|(_, v)| v).collect();
-    let col = |g: &[[f64; 7]], k: usize| median(g.iter().map(|x| x[k])).unwrap_or(f64::NAN);
-    let mut levels: Vec<Level> = groups
-        .iter()
-        .filter(|g| g.len() >= MIN_SAMPLES)
-        .map(|g| {
-            let (fz, srm, re, vx, om) = (col(g, 0), col(g, 1), col(g, 2), col(g, 3), col(g, 4));
-            let (p, gamma) = (col(g, 5), col(g, 6));
-            let fx = |k: f64| {
-                tyre.evaluate(
-                    &MfInput {
-                        fz,
-                        kappa: k,
-                        alpha: 0.0,
-                        gamma: if gamma.is_finite() { gamma } else { 0.0 },
-                        phit: 0.0,
-                        vx,
-                        p: if p.is_finite() { p } else { 0.0 },
-                        omega: om,
-                    },
-                    UseMode::default(),
-                )
-                .fx
-            };
-            let kx = (fx(0.002) - fx(-0.002)) / 0.004;
-            Level {
-                fz,
-                n: g.len(),
-                sr: srm,
-                re_free: re,
-                re_slip: re * (1.0 + srm),
-                re_base: f64::NAN,
-                re_extended: f64::NAN,
-                kx,
-                force_share: f64::NAN,
-                vx,
-                omega: om,
-                p,
-                gamma,
-            }
-        })
-        .collect();
     if levels.len() < MIN_LEVELS || levels.iter().any(|l| !l.kx.is_finite()) {
         return None;
     }
@@ -198,11 +144,231 @@ pub fn check(rec: &Recording, tyre: &Tyre) -> Option<SlipChannel> {
             (a.0.min(l.sr), a.1.max(l.sr))
         });
     Some(SlipChannel {
+        from,
+        fx_zero,
         levels,
         sr_span: hi - lo,
         force_share: share,
         found: share > FORCE_SHARE,
     })
+}
+
+/// The free-rolling samples' load levels of the pure lateral sweeps: per
+/// level the median SR and V/Ω of the samples at |α| < 1° (no drive or
+/// brake torque, so V/Ω is the effective rolling radius).
+fn lateral_levels(rec: &Recording, sr: &[f64], fmax: f64, tyre: &Tyre) -> Vec<Level> {
+    // (fz, sr, V/Ω, vx, Ω, p, γ) of each level's free-rolling samples.
+    let groups = by_level(rec, SegmentKind::PureLateral, fmax, |i| {
+        let s = &rec.samples[i];
+        let r = sr.get(i).copied().unwrap_or(f64::NAN);
+        upright_rolling(s, r, fmax, 0.1)
+            .then(|| [s.fz, r, s.vx / s.omega, s.vx, s.omega, s.p, s.gamma])
+    });
+    let col = |g: &[[f64; 7]], k: usize| median(g.iter().map(|x| x[k])).unwrap_or(f64::NAN);
+    groups
+        .iter()
+        .filter(|g| g.len() >= MIN_SAMPLES)
+        .map(|g| {
+            let (fz, srm, re, vx, om) = (col(g, 0), col(g, 1), col(g, 2), col(g, 3), col(g, 4));
+            level(tyre, g.len(), [fz, srm, re, vx, om, col(g, 5), col(g, 6)])
+        })
+        .collect()
+}
+
+/// Whether sample `s`, with recorded slip ratio `sr`, can be read for the
+/// radius: |α| < 1°, loaded above 10 % of the largest load, rolling (Ω and
+/// V above 1), and |SR| below `sr_max`.
+fn upright_rolling(s: &crate::data::Sample, sr: f64, fmax: f64, sr_max: f64) -> bool {
+    s.alpha.abs() < 1f64.to_radians()
+        && s.fz > 0.1 * fmax
+        && s.omega > 1.0
+        && s.vx > 1.0
+        && sr.is_finite()
+        && sr.abs() < sr_max
+}
+
+/// Half-width of the slip window about free rolling in which a drive/brake
+/// sweep's Fx is taken as linear in SR: 2 %, inside the linear range of
+/// any tyre's Fx(κ) (the peak lies at 5–20 %).
+const LINEAR_SR: f64 = 0.02;
+
+/// The free-rolling point of the pure drive/brake sweeps at |α| < 1°, for
+/// a recording without free-rolling lateral sweeps (a drive/brake run):
+/// per load level, the SR at which Fx crosses zero (a straight line
+/// Fx = a + b·SR through the samples with |SR| < [`LINEAR_SR`]; zero
+/// longitudinal force is free rolling) and the radius SR was computed with,
+/// R = V·(1 + SR)/Ω, which does not move with the slip (median over the
+/// same samples); the tyre's effective rolling radius there is
+/// R/(1 + SR₀). The samples under torque are used only through that line.
+fn drive_brake_levels(rec: &Recording, sr: &[f64], fmax: f64, tyre: &Tyre) -> Vec<Level> {
+    // (fz, sr, V(1+SR)/Ω, vx, fx, p, γ) of each level's near-zero-slip samples.
+    let groups = by_level(rec, SegmentKind::PureLongitudinal, fmax, |i| {
+        let s = &rec.samples[i];
+        let r = sr.get(i).copied().unwrap_or(f64::NAN);
+        (upright_rolling(s, r, fmax, LINEAR_SR) && s.fx.is_finite()).then(|| {
+            [
+                s.fz,
+                r,
+                s.vx * (1.0 + r) / s.omega,
+                s.vx,
+                s.fx,
+                s.p,
+                s.gamma,
+            ]
+        })
+    });
+    let col = |g: &[[f64; 7]], k: usize| median(g.iter().map(|x| x[k])).unwrap_or(f64::NAN);
+    groups
+        .iter()
+        .filter(|g| g.len() >= MIN_SAMPLES)
+        .filter_map(|g| {
+            // Least squares Fx = a + b·SR.
+            let n = g.len() as f64;
+            let (mx, my) = (
+                g.iter().map(|x| x[1]).sum::<f64>() / n,
+                g.iter().map(|x| x[4]).sum::<f64>() / n,
+            );
+            let sxx: f64 = g.iter().map(|x| (x[1] - mx).powi(2)).sum();
+            let sxy: f64 = g.iter().map(|x| (x[1] - mx) * (x[4] - my)).sum();
+            // The line needs slip spread (a sweep, not a hold) and a
+            // positive slope (drive force with drive slip).
+            if !(sxx > n * (0.25 * LINEAR_SR).powi(2) && sxy > 0.0) {
+                return None;
+            }
+            let b = sxy / sxx;
+            let sr0 = mx - my / b;
+            if !(sr0.abs() < LINEAR_SR) {
+                return None;
+            }
+            let (fz, r, vx) = (col(g, 0), col(g, 2), col(g, 3));
+            let re = r / (1.0 + sr0);
+            Some(level(
+                tyre,
+                g.len(),
+                [fz, sr0, re, vx, vx / re, col(g, 5), col(g, 6)],
+            ))
+        })
+        .collect()
+}
+
+/// Takes the Fx sensor zero error out of drive/brake levels; returns it
+/// (N). A zero error ΔFx moves the zero-Fx crossing by −ΔFx/K_x, most at
+/// the smallest load (−44 N reads as a 0.4 % slip at 0.8 kN on a car
+/// tyre: a radius "found" from a sensor zero), while a radius that is not
+/// the tyre's moves it by R/Re(Fz) − 1, smooth in the load (Re falls about
+/// linearly with Fz over a test's loads: Pacejka, *Tire and Vehicle
+/// Dynamics*, 3rd ed., eq. 9.236 with ρ = Fz/C_z). So the levels' SR is
+/// fitted as c + d·(Fz − F̄z) − ΔFx/K_x (least squares; c a zero error of
+/// SR, as on the lateral sweeps) and ΔFx/K_x is added back at each level,
+/// with the free-rolling radius re-read there. None when the three terms
+/// cannot be told apart (a singular fit).
+fn remove_fx_zero(levels: &mut [Level]) -> Option<f64> {
+    use nalgebra::{DMatrix, DVector};
+    let n = levels.len();
+    let fbar = levels.iter().map(|l| l.fz).sum::<f64>() / n as f64;
+    let cols = |l: &Level| [1.0, l.fz - fbar, 1.0 / l.kx];
+    // Columns scaled to unit norm, so that one tolerance fits all three.
+    let norm: Vec<f64> = (0..3)
+        .map(|j| {
+            levels
+                .iter()
+                .map(|l| cols(l)[j].powi(2))
+                .sum::<f64>()
+                .sqrt()
+        })
+        .collect();
+    if norm.iter().any(|v| !(*v > 0.0)) {
+        return None;
+    }
+    let a = DMatrix::from_fn(n, 3, |i, j| cols(&levels[i])[j] / norm[j]);
+    let y = DVector::from_fn(n, |i, _| levels[i].sr);
+    let svd = a.svd(true, true);
+    // Columns that one load law and one Fx zero cannot tell apart.
+    if svd.singular_values.min() < 1e-6 * svd.singular_values.max() {
+        return None;
+    }
+    let x = svd.solve(&y, 0.0).ok()?;
+    // SR measured = SR true − ΔFx/K_x: the 1/K_x coefficient is −ΔFx.
+    let zero = -x[2] / norm[2];
+    if !zero.is_finite() {
+        return None;
+    }
+    for l in levels.iter_mut() {
+        l.sr += zero / l.kx;
+        l.re_free = l.re_slip / (1.0 + l.sr);
+    }
+    Some(zero)
+}
+
+/// The rows `keep` gives for the samples of the segments of `kind`, grouped
+/// by the segments' load set points (within 5 % of the largest load) and
+/// ordered by load.
+fn by_level(
+    rec: &Recording,
+    kind: SegmentKind,
+    fmax: f64,
+    keep: impl Fn(usize) -> Option<[f64; 7]>,
+) -> Vec<Vec<[f64; 7]>> {
+    let mut groups: Vec<(f64, Vec<[f64; 7]>)> = Vec::new();
+    for g in rec
+        .segments
+        .iter()
+        .filter(|g| g.kind == kind && g.fz.is_finite())
+    {
+        let k = match groups
+            .iter()
+            .position(|(f, _)| (f - g.fz).abs() < 0.05 * fmax)
+        {
+            Some(k) => k,
+            None => {
+                groups.push((g.fz, Vec::new()));
+                groups.len() - 1
+            }
+        };
+        groups[k]
+            .1
+            .extend((g.start..g.end.min(rec.samples.len())).filter_map(&keep));
+    }
+    groups.sort_by(|a, b| a.0.total_cmp(&b.0));
+    groups.into_iter().map(|(_, v)| v).collect()
+}
+
+/// A level from its `n` samples' [fz, SR, V/Ω, vx, Ω, p, γ] at free
+/// rolling, with the baseline's slip stiffness there.
+fn level(tyre: &Tyre, n: usize, v: [f64; 7]) -> Level {
+    let [fz, srm, re, vx, om, p, gamma] = v;
+    let fx = |k: f64| {
+        tyre.evaluate(
+            &MfInput {
+                fz,
+                kappa: k,
+                alpha: 0.0,
+                gamma: if gamma.is_finite() { gamma } else { 0.0 },
+                phit: 0.0,
+                vx,
+                p: if p.is_finite() { p } else { 0.0 },
+                omega: om,
+            },
+            UseMode::default(),
+        )
+        .fx
+    };
+    let kx = (fx(0.002) - fx(-0.002)) / 0.004;
+    Level {
+        fz,
+        n,
+        sr: srm,
+        re_free: re,
+        re_slip: re * (1.0 + srm),
+        re_base: f64::NAN,
+        re_extended: f64::NAN,
+        kx,
+        force_share: f64::NAN,
+        vx,
+        omega: om,
+        p,
+        gamma,
+    }
 }
 
 impl SlipChannel {
@@ -331,7 +497,11 @@ impl SlipChannel {
             .unwrap_or(first);
         let g = |t: &Tyre, k: &str| t.params().get(k).unwrap_or(f64::NAN);
         format!(
-            "rolling_radius: the recorded slip ratio SR was computed with a rolling radius that is not the tyre's. At free rolling (pure lateral sweeps, |α| < 1°) SR reads {:+.2} % at {:.2} kN and {:+.2} % at {:.2} kN, while the wheel's own effective radius V/Ω goes from {:.1} to {:.1} mm and the radius SR assumes from {:.1} to {:.1} mm. Read as slip, that is a load-dependent Fx of up to {:.0} % of Fz (K_x·ΔSR at {:.2} kN); the baseline absorbed it in its horizontal shift of Fx (PHX1 {:.4}, PHX2 {:.4}: a slip offset and a radius are the same to the forces). The extended file carries the tyre's own Re(Fz) (Q_RE0 {:.4} → {:.4}, DREFF {:.3} → {:.3}, FREFF {:.3} → {:.3}) with PHX1 {:.4}, PHX2 {:.4}, so the FMU fed the wheel speed gives the slip the tyre sees.",
+            "rolling_radius: the recorded slip ratio SR was computed with a rolling radius that is not the tyre's. At free rolling ({}{}) SR reads {:+.2} % at {:.2} kN and {:+.2} % at {:.2} kN, while the wheel's own effective radius V/Ω goes from {:.1} to {:.1} mm and the radius SR assumes from {:.1} to {:.1} mm. Read as slip, that is a load-dependent Fx of up to {:.0} % of Fz (K_x·ΔSR at {:.2} kN); the baseline absorbed it in its horizontal shift of Fx (PHX1 {:.4}, PHX2 {:.4}: a slip offset and a radius are the same to the forces). The extended file carries the tyre's own Re(Fz) (Q_RE0 {:.4} → {:.4}, DREFF {:.3} → {:.3}, FREFF {:.3} → {:.3}) with PHX1 {:.4}, PHX2 {:.4}, so the FMU fed the wheel speed gives the slip the tyre sees.",
+            self.from,
+            self.fx_zero.map_or(String::new(), |z| format!(
+                "; an Fx zero error of {z:+.0} N fitted beside the load law and taken out"
+            )),
             100.0 * first.sr,
             first.fz / 1e3,
             100.0 * last.sr,
@@ -465,6 +635,93 @@ mod tests {
         let c = check(&rec, &tyre()).unwrap();
         assert!(c.sr_span < 1e-9);
         assert!(!c.found && c.force_share < 1e-6, "{}", c.force_share);
+    }
+
+    /// A drive/brake run (no lateral sweeps): per load, a slip sweep at
+    /// α = 0 through true slip κ ∈ [−5 %, +5 %] with Fx = K_x·κ + `zero`
+    /// (K_x the test tyre's own, so that the zero error's slip is exactly
+    /// −zero/K_x), the wheel at Ω = V·(1 + κ)/Re(Fz) and the SR the rig
+    /// computes with its radius.
+    fn drive_rig(
+        loads: &[f64],
+        re: impl Fn(f64) -> f64,
+        r_rig: impl Fn(f64) -> f64,
+        zero: f64,
+    ) -> Recording {
+        let mut rec = rig(&[], &re, &r_rig);
+        let mut sr = Vec::new();
+        let v = 11.0;
+        for &fz in loads {
+            let kx = level(&tyre(), 1, [fz, 0.0, re(fz), v, v / re(fz), 2.2e5, 0.0]).kx;
+            let start = rec.samples.len();
+            for k in 0..400 {
+                let kappa = 0.1 * (k as f64 / 400.0 - 0.5);
+                let omega = v * (1.0 + kappa) / re(fz);
+                rec.samples.push(Sample {
+                    time: rec.samples.len() as f64 * 0.01,
+                    vx: v,
+                    omega,
+                    fz,
+                    fx: kx * kappa + zero,
+                    p: 2.2e5,
+                    ..Default::default()
+                });
+                sr.push(omega * r_rig(fz) / v - 1.0);
+            }
+            rec.segments.push(Segment {
+                start,
+                end: rec.samples.len(),
+                kind: SegmentKind::PureLongitudinal,
+                fz,
+                gamma: 0.0,
+                p: 2.2e5,
+                vx: v,
+                alpha: 0.0,
+            });
+        }
+        let n = rec.samples.len();
+        rec.extra = vec![("SR".into(), sr)];
+        rec.sweep_dir = vec![0; n];
+        rec.t_in_segment = vec![0.0; n];
+        rec
+    }
+
+    /// Without lateral sweeps the radius is read where the drive/brake
+    /// sweeps' Fx crosses zero, with an Fx zero error fitted beside the load
+    /// law: a constant rig radius against an Re falling 3 % over the loads
+    /// is found whatever the zero error, with the tyre's own radius at every
+    /// level within 0.2 mm and the zero error within 10 N (R/Re(Fz) − 1 is
+    /// not quite linear in Fz, and the 1/K_x term takes up some of its
+    /// curvature: −5.7 N without a zero error); the tyre's own radius with
+    /// a constant SR offset is not found, though a 60 N zero error alone
+    /// moves the crossing at 0.8 kN by K_x·ΔSR = 60 N, 7.5 % of its load —
+    /// the zero error comes back within 0.3 N there (SR = 0.996·(1 + κ) − 1
+    /// scales κ by 0.996, and the crossing's 1/K_x term with it).
+    #[test]
+    fn a_drive_brake_run_is_read_at_zero_fx() {
+        let re = |fz: f64| 0.31 - 2e-6 * fz;
+        let loads = [800.0, 1600.0, 2400.0, 4000.0, 5600.0];
+        for zero in [0.0, 60.0] {
+            let c = check(&drive_rig(&loads, re, |_| 0.304, zero), &tyre()).unwrap();
+            assert!(c.from.contains("drive/brake"), "{}", c.from);
+            assert_eq!(c.levels.len(), 5);
+            for l in &c.levels {
+                assert!(
+                    (l.re_free - re(l.fz)).abs() < 2e-4,
+                    "{} vs {}",
+                    l.re_free,
+                    re(l.fz)
+                );
+                assert!((l.re_slip - 0.304).abs() < 1e-6);
+            }
+            assert!(c.found, "share {}", c.force_share);
+            assert!((c.fx_zero.unwrap() - zero).abs() < 10.0, "{:?}", c.fx_zero);
+            let c = check(&drive_rig(&loads, re, |fz| re(fz) * 0.996, zero), &tyre()).unwrap();
+            assert!(!c.found && c.force_share < 1e-3, "{}", c.force_share);
+            assert!((c.fx_zero.unwrap() - zero).abs() < 0.3, "{:?}", c.fx_zero);
+        }
+        // Four levels fit three terms with one to spare; three do not.
+        assert!(check(&drive_rig(&loads[..3], re, |_| 0.304, 0.0), &tyre()).is_none());
     }
 
     /// Two load levels cannot tell a load law from an offset.

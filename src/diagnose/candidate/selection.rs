@@ -4,8 +4,9 @@
 //!
 //! Must never: name an effect that makes any channel's held-out error worse
 //! by more than [`MAX_LOSS`], or one without a channel whose held-out gain
-//! exceeds [`MIN_GAIN`] and whose own BIC falls, or one whose gain another
-//! candidate dwarfs in the same channel ([`OVERSHADOW`]).
+//! exceeds [`MIN_GAIN`], whose own BIC falls and whose baseline misfit, if
+//! any, it mostly explains ([`ChannelScore::baseline_misfit`]), or one whose gain
+//! another candidate dwarfs in the same channel ([`OVERSHADOW`]).
 
 use super::{ChannelScore, Evaluation, Fitted};
 use crate::residual::Channel;
@@ -40,8 +41,20 @@ pub const MAX_LOSS: f64 = 0.05;
 pub const OVERSHADOW: f64 = 2.0;
 
 /// Whether channel `c` shows the effect: its held-out error falls by more
-/// than [`MIN_GAIN`] and its own BIC falls.
+/// than [`MIN_GAIN`], its own BIC falls, and the baseline fits the channel
+/// within the noise or the candidate takes most of the misfit away
+/// ([`ChannelScore::baseline_misfit`]). Where the baseline itself misfits
+/// (issue #15, "no verdict on a bad baseline"), any flexible candidate
+/// removes part of the baseline's own error, and a small gain says nothing
+/// about the physics: a drive/brake-only run, whose combined-slip Fy the
+/// baseline fits at 9–17× the noise floor, had its Fy gains read as LuGre.
 fn shows(c: &ChannelScore) -> bool {
+    gains(c) && c.baseline_misfit.is_none()
+}
+
+/// Whether channel `c`'s held-out error falls by more than [`MIN_GAIN`] and
+/// its own BIC falls, whatever the baseline's fit there.
+fn gains(c: &ChannelScore) -> bool {
     c.oos_gain > MIN_GAIN && c.delta_bic < 0.0
 }
 
@@ -233,6 +246,24 @@ pub fn why_not(e: &Evaluation) -> Option<String> {
         )
     } else if !(e.oos_gain > 0.0 && e.fit_gain > 0.0) {
         "the channels together do not gain both in and out of sample".into()
+    } else if e.channels.iter().any(gains) {
+        let misfit: Vec<String> = e
+            .channels
+            .iter()
+            .filter(|c| gains(c))
+            .map(|c| {
+                format!(
+                    "{} {:.1} %: {}",
+                    c.channel.name(),
+                    100.0 * c.oos_gain,
+                    c.baseline_misfit.as_deref().unwrap_or("")
+                )
+            })
+            .collect();
+        format!(
+            "its gain lies where the baseline itself misfits ({}), so it may be the baseline's own error that it removes, not this physics",
+            misfit.join("; ")
+        )
     } else {
         let bics: Vec<String> = e
             .channels
@@ -270,6 +301,7 @@ mod tests {
                     oos_gain: g,
                     fit_gain: g,
                     delta_bic: b,
+                    baseline_misfit: None,
                 })
                 .collect(),
             parameters: vec![],
@@ -307,6 +339,33 @@ mod tests {
         );
         assert!(!qualifies(&e));
         assert!(why_not(&e).unwrap().contains("Fy"));
+    }
+
+    /// A gain only where the baseline itself misfits names nothing (a
+    /// drive/brake-only run: LuGre removed 9.5 % of a combined-slip Fy the
+    /// baseline fitted at 13× the noise floor), and the reason says so; the
+    /// same gain in a channel the baseline fits names the effect, and a
+    /// second, well-fitted channel that shows it names it too.
+    #[test]
+    fn a_gain_where_the_baseline_misfits_names_nothing() {
+        let mut e = ev(
+            &[(Channel::Fx, 0.015, 6.0), (Channel::Fy, 0.095, -7.1)],
+            0.03,
+            6.1,
+        );
+        assert!(qualifies(&e), "the well-fitted case");
+        e.channels[1].baseline_misfit = Some("its residual stands above 3× the noise floor".into());
+        assert!(!qualifies(&e));
+        let w = why_not(&e).unwrap();
+        assert!(w.contains("misfits") && w.contains("Fy 9.5 %"), "{w}");
+        let ev2 = [with_fitted(e.clone(), "lugre")];
+        assert_eq!(select(&ev2), None);
+        e.channels[0] = ChannelScore {
+            oos_gain: 0.04,
+            delta_bic: -3.3,
+            ..e.channels[0].clone()
+        };
+        assert!(qualifies(&e), "evidence in the well-fitted Fx");
     }
 
     /// An effect that lives in one channel (a friction law of the sliding

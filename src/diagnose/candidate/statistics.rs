@@ -33,6 +33,16 @@ pub struct ChannelScore {
     /// that act on the channel ([`Fitted::parameters_on`]; all of them when
     /// the candidate declares none for it). See [`evaluate`].
     pub delta_bic: f64,
+    /// Why the baseline's own misfit of this channel leaves the candidate's
+    /// gain there no evidence, when it does: the baseline's held-out
+    /// residual stands above [`crate::diagnose::report::MISFIT_RATIO`] × the
+    /// noise floor the data show and the candidate removes less than
+    /// [`crate::diagnose::report::MISFIT_EXPLAINED`] of the excess, or (Fx)
+    /// the slip input was computed with a radius that is not the tyre's
+    /// (`diagnose::slip_channel`). Such a channel cannot carry the evidence
+    /// for a verdict (see `selection`). Set by the diagnosis after the
+    /// evaluation; None until then.
+    pub baseline_misfit: Option<String>,
 }
 
 /// A candidate's evaluation.
@@ -340,6 +350,7 @@ pub fn evaluate(
                                 };
                                 n * (s[2][j].0 / sb[2][j].0).max(1e-300).ln() + kj as f64 * n.ln()
                             },
+                            baseline_misfit: None,
                         })
                         .collect();
                     Ok((

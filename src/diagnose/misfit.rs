@@ -104,8 +104,9 @@ pub fn misfit_note(fits: &[BaselineFit]) -> Option<String> {
         return None;
     }
     Some(format!(
-        "Baseline misfit: the baseline's held-out {} — more than {MISFIT_RATIO:.0}× the sensor noise the data show; a candidate that removes a fragment of such a misfit may be fitting the baseline's own error, and none removes most of it while showing its effect, so no effect is named.",
-        bad.join("; ")
+        "Baseline misfit: the baseline's held-out {} — more than {MISFIT_RATIO:.0}× the sensor noise the data show; a candidate that removes a fragment of such a misfit may be fitting the baseline's own error, and none removes {:.0} % of its excess over the noise while showing its effect, so no effect is named.",
+        bad.join("; "),
+        100.0 * MISFIT_EXPLAINED
     ))
 }
 

@@ -298,7 +298,7 @@ pub fn diagnose_with(
     step("report");
     // The baseline against the noise floor, before any verdict: a channel
     // the baseline itself misfits carries a candidate's evidence only when
-    // the candidate takes most of the misfit away (MISFIT_EXPLAINED).
+    // the candidate takes a good part of the misfit away (MISFIT_EXPLAINED).
     let (fit_r, test_r) = split(rec);
     let mask = |rs: &[Range<usize>]| {
         let mut m = vec![false; rec.samples.len()];

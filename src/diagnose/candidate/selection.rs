@@ -5,8 +5,8 @@
 //! Must never: name an effect that makes any channel's held-out error worse
 //! by more than [`MAX_LOSS`], or one without a channel whose held-out gain
 //! exceeds [`MIN_GAIN`], whose own BIC falls and whose baseline misfit, if
-//! any, it mostly explains ([`ChannelScore::baseline_misfit`]), or one whose gain
-//! another candidate dwarfs in the same channel ([`OVERSHADOW`]).
+//! any, it explains in good part ([`ChannelScore::baseline_misfit`]), or one
+//! whose gain another candidate dwarfs in the same channel ([`OVERSHADOW`]).
 
 use super::{ChannelScore, Evaluation, Fitted};
 use crate::residual::Channel;
@@ -42,8 +42,8 @@ pub const OVERSHADOW: f64 = 2.0;
 
 /// Whether channel `c` shows the effect: its held-out error falls by more
 /// than [`MIN_GAIN`], its own BIC falls, and the baseline fits the channel
-/// within the noise or the candidate takes most of the misfit away
-/// ([`ChannelScore::baseline_misfit`]). Where the baseline itself misfits
+/// within the noise or the candidate takes a good part of the misfit away
+/// ([`ChannelScore::baseline_misfit`]: a third of the excess over the noise). Where the baseline itself misfits
 /// (issue #15, "no verdict on a bad baseline"), any flexible candidate
 /// removes part of the baseline's own error, and a small gain says nothing
 /// about the physics: a drive/brake-only run, whose combined-slip Fy the

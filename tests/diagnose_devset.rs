@@ -467,15 +467,19 @@ fn devset_shortened_programmes_name_no_wrong_effect() {
 /// above 3 %; the cornering sweeps and the warm-up gone, the recorded
 /// times kept), as a TTC drive/brake run file comes without cornering
 /// sweeps; the three cornering-only programmes have no such rows and are
-/// left out. The baseline then fits the combined-slip Fy and Mz at 7–17×
-/// the noise floor, and a gain there is no evidence
-/// (`ChannelScore::baseline_misfit`); the rolling radius is read where
-/// the sweeps' Fx crosses zero (`diagnose::slip_channel`). Measured 29 Nov
-/// 2026: 9 of 15 named (r02, r05, r07, r10, r12, r13, r17, r18, r19),
-/// controls `none`, none wrong (166 s); before those two rules r04
-/// (pressure) and r18 (relaxation) were named `lugre` on Fy gains the
-/// baseline's misfit offered, and r02, r07, r10 (rolling radius) `none`,
-/// `none` and `speed_friction`.
+/// left out. The baseline reads Fy0 from the rows near free rolling and
+/// leaves Mz to the start tyre (`fit::mf_fit::FREE_ROLLING_KAPPA`; Mz is
+/// then not diagnosed), a gain on a channel the baseline misfits is no
+/// evidence (`ChannelScore::baseline_misfit`), and the rolling radius is
+/// read where the sweeps' Fx crosses zero (`diagnose::slip_channel`).
+/// Measured 29 Nov 2026: 9 of 15 named (r02, r05, r07, r10, r12, r13, r17,
+/// r18, r19), controls `none`, none wrong (166 s), with a baseline that
+/// fitted Fy at 7–17× the noise floor (σ_Fy 48 %, Fy0 the start tyre's);
+/// with Fy0 fitted (σ_Fy 2.6–4.4 %) again 9 — r11 named, r12 `none` (its
+/// load law gains 7 % in Fx and loses 8 % in Fy) —, none wrong. Before the
+/// misfit and radius rules r04 (pressure) and r18 (relaxation) were named
+/// `lugre` on Fy gains the baseline's misfit offered, and r02, r07, r10
+/// (rolling radius) `none`, `none` and `speed_friction`.
 #[test]
 fn devset_drive_brake_runs_name_no_wrong_effect() {
     let Some(v) = variant_verdicts("diagnose_devset_drive_brake", drive_brake_only) else {

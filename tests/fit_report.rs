@@ -128,8 +128,7 @@ fn report_table_is_aligned_and_json_round_trips() {
         sources: vec!["test".into()],
         stages: vec![out],
         metrics: evaluate(&r, "Fy", &sim, None).unwrap(),
-        holdout_metrics: vec![],
-        relaxation: vec![],
+        ..Default::default()
     };
     let text = rep.to_text();
     assert!(text.contains("Stage 'line'") && text.contains("sigma [%]"));

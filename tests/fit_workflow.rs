@@ -128,7 +128,7 @@ fn fit_on_some_conditions_predicts_the_held_out_ones() {
         stages: vec![out],
         metrics: fitted,
         holdout_metrics: held,
-        relaxation: vec![],
+        ..Default::default()
     };
     let text = report.to_text();
     assert!(text.contains("Quality (held-out data)"), "{text}");

@@ -91,24 +91,15 @@ impl Baseline {
     pub fn compared(&self) -> &TyreParams {
         self.zeroed.as_ref().unwrap_or(&self.tyre)
     }
-    /// (channel, segment kind) pairs the fit fitted
-    /// ([`StageKind::segments_and_channels`] of its stages).
+    /// (channel, segment kind) pairs of the force and moment channels the
+    /// fit fitted ([`crate::fit::FitReport::fitted`]).
     pub fn fitted(&self) -> Vec<(Channel, SegmentKind)> {
-        let mut fitted = Vec::new();
-        for st in &self.report.stages {
-            for k in [
-                StageKind::PureFx,
-                StageKind::PureFy,
-                StageKind::Mz,
-                StageKind::Combined,
-            ] {
-                if k.name() == st.stage {
-                    let (seg, chans) = k.segments_and_channels();
-                    fitted.extend(chans.iter().map(|&c| (c, seg)));
-                }
-            }
-        }
-        fitted
+        self.report
+            .fitted
+            .iter()
+            .filter_map(|(n, seg)| Channel::parse(n).map(|c| (c, *seg)))
+            .filter(|(c, _)| Channel::SCORED.contains(c))
+            .collect()
     }
 }
 

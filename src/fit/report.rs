@@ -26,6 +26,13 @@ pub struct FitReport {
     /// The relaxation-length stage, one entry per direction (empty unless run).
     #[serde(default)]
     pub relaxation: Vec<RelaxationFit>,
+    /// (channel name, segment kind) of every channel a stage fitted, in
+    /// stage order: a stage's channels where recorded, on the rows it
+    /// fitted them on (the pure Fy stage of data without cornering sweeps
+    /// fits the drive/brake rows near free rolling, and the combined stage
+    /// leaves Mz out where no stage fitted its pure-slip shape).
+    #[serde(default)]
+    pub fitted: Vec<(String, crate::data::SegmentKind)>,
 }
 
 impl FitReport {

@@ -157,7 +157,8 @@ pub(crate) fn accept_combined(
     let mut polished = after.clone();
     let mut outs = Vec::new();
     for &k in pure {
-        if let StageRun::Done(o, _) = run_stage(ctx, k, &polished, false, progress.as_deref_mut())?
+        if let StageRun::Done { out: o, .. } =
+            run_stage(ctx, k, &polished, false, progress.as_deref_mut())?
         {
             for p in &o.params {
                 polished.set(&p.name, p.value)?;

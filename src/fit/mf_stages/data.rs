@@ -43,6 +43,17 @@ impl StageData {
         self.gamma_spread = self.gamma_spread.max(other.gamma_spread);
         self.p_spread = self.p_spread.max(other.p_spread);
     }
+    /// Keep the samples whose conditions satisfy `keep` (spreads kept).
+    pub fn retain(&mut self, keep: impl Fn(&Conditions) -> bool) {
+        let on: Vec<bool> = self.conds.iter().map(&keep).collect();
+        let pick = |v: &mut Vec<f64>| {
+            let mut k = on.iter();
+            v.retain(|_| *k.next().unwrap_or(&false));
+        };
+        self.meas.iter_mut().for_each(pick);
+        let mut k = on.iter();
+        self.conds.retain(|_| *k.next().unwrap_or(&false));
+    }
     /// Every `k`-th sample (spreads kept: they decide which terms are held).
     pub fn every(&self, k: usize) -> StageData {
         let k = k.max(1);

@@ -338,7 +338,7 @@ fn mz_shape_fitted(ctx: &StageCtx, tyre: &TyreParams) -> bool {
 /// load (4.E25), which a few loads on one slip-angle level cannot tell from
 /// PKY1–2; PVY1–2 (4.E29) trade with the horizontal shift PHY1–2 when the
 /// slip angles have one sign (a TTC drive/brake run's 0, −3, −6°): fitted
-/// freely, the first such fit moved PVY1 to its bound −0.5 and PKY1 to 4–8×
+/// freely, the first such fit moved PVY1 to its bound −0.5 and PKY1 to 2–9×
 /// the generating file's, a curve that fits three slip angles and nothing
 /// else. The peak and stiffness levels and their load trends (PDY1–2,
 /// PKY1–2) and the offsets PHY1–2 stay fitted.

@@ -139,13 +139,11 @@ pub fn decimate(rec: &Recording, k: usize) -> Recording {
 
 /// Blank (NaN) each force channel among Fx, Fy, Mz on the segments of a
 /// kind the baseline fit did not fit it on, and drop a channel no stage fit
-/// at all (e.g. Fx of a lateral-only test, where Fx is rig crosstalk). The
-/// stages fit Fx on drive/brake and combined segments, Fy on cornering and
-/// combined ones, Mz on cornering ones only
-/// ([`StageKind::segments_and_channels`]): elsewhere the baseline's value is
-/// the start tyre's, not a fit (Mz under braking comes from SSZ*, which
-/// cornering data cannot determine), and its residual would be named as a
-/// missing physics. Returns the channels dropped entirely; the diagnosis
+/// at all (e.g. Fx of a lateral-only test, where Fx is rig crosstalk), as
+/// the fit recorded them ([`Baseline::fitted`]; e.g. Mz of a drive/brake
+/// run without cornering sweeps, whose shape no stage could fit): elsewhere
+/// the baseline's value is the start tyre's, not a fit, and its residual
+/// would be named as a missing physics. Returns the channels dropped entirely; the diagnosis
 /// skips blanked samples (scores, locate, plots).
 pub fn drop_unfitted(recs: &mut [Recording], b: &Baseline) -> Vec<&'static str> {
     let fitted = b.fitted();

@@ -293,3 +293,42 @@ fn noisy_samples(
         t_in_segment,
     }
 }
+
+/// σ of Fy (RMS residual / RMS measured) of `model` over the drive/brake
+/// (combined-slip) rows of `rec` with |α| ≥ `min_alpha` (rad), evaluated in
+/// the fit's use mode; `offsets`: the rig's α and Fy offsets, applied to the
+/// model where given (the truth), not to a fitted tyre (which absorbs them).
+pub fn combined_sigma_fy(
+    rec: &tyrekit::data::Recording,
+    model: &Tyre,
+    offsets: Option<&tyrekit::rig::Noise>,
+    min_alpha: f64,
+) -> f64 {
+    use tyrekit::data::SegmentKind;
+    let (mut e2, mut y2) = (0.0, 0.0);
+    let (da, dy) = offsets.map_or((0.0, 0.0), |n| (n.alpha_offset, n.fy_offset));
+    for g in rec
+        .segments
+        .iter()
+        .filter(|g| g.kind == SegmentKind::Combined)
+    {
+        for s in &rec.samples[g.start..g.end.min(rec.samples.len())] {
+            if !(s.fy.is_finite() && s.fz > 0.0 && s.alpha.abs() >= min_alpha) {
+                continue;
+            }
+            let x = MfInput {
+                fz: s.fz,
+                kappa: s.kappa,
+                alpha: s.alpha - da,
+                gamma: s.gamma,
+                vx: s.vx,
+                p: s.p,
+                ..Default::default()
+            };
+            let e = model.forces(&x, tyrekit::fit::mf_stages::USE_MODE).fy + dy - s.fy;
+            e2 += e * e;
+            y2 += s.fy * s.fy;
+        }
+    }
+    (e2 / y2).sqrt()
+}

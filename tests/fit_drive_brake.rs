@@ -17,8 +17,9 @@ mod common;
 
 use tyrekit::data::{Recording, SegmentKind};
 use tyrekit::fit::mf_fit::{fit_mf, MfFitOptions};
-use tyrekit::mf::Tyre;
-use tyrekit::rig::{simulate, RigConfig, SteadyMf};
+use tyrekit::fit::mf_stages::USE_MODE;
+use tyrekit::mf::{MfInput, Tyre};
+use tyrekit::rig::{simulate, Noise, RigConfig, SteadyMf};
 use tyrekit::tir::TyreParams;
 
 /// The built-in tyre with 10 % less peak friction, 25 % less cornering
@@ -53,6 +54,37 @@ fn recording(truth: &Tyre, dir: &std::path::Path) -> Recording {
     Recording::from_file(&path).expect("read back the rig recording")
 }
 
+/// σ of Fy (RMS residual / RMS measured) of `model` over the combined rows,
+/// with `offsets` (α and Fy offsets the rig adds to the record) applied.
+fn sigma_fy(rec: &Recording, model: &Tyre, offsets: Option<&Noise>) -> f64 {
+    let (mut e2, mut y2) = (0.0, 0.0);
+    for g in rec
+        .segments
+        .iter()
+        .filter(|g| g.kind == SegmentKind::Combined)
+    {
+        for s in &rec.samples[g.start..g.end.min(rec.samples.len())] {
+            if !(s.fy.is_finite() && s.fz > 0.0) {
+                continue;
+            }
+            let (da, dy) = offsets.map_or((0.0, 0.0), |n| (n.alpha_offset, n.fy_offset));
+            let x = MfInput {
+                fz: s.fz,
+                kappa: s.kappa,
+                alpha: s.alpha - da,
+                gamma: s.gamma,
+                vx: s.vx,
+                p: s.p,
+                ..Default::default()
+            };
+            let e = model.forces(&x, USE_MODE).fy + dy - s.fy;
+            e2 += e * e;
+            y2 += s.fy * s.fy;
+        }
+    }
+    (e2 / y2).sqrt()
+}
+
 #[test]
 fn a_drive_brake_run_fits_fy_without_cornering_sweeps() {
     let truth_p = truth();
@@ -71,12 +103,12 @@ fn a_drive_brake_run_fits_fy_without_cornering_sweeps() {
     let rec = &recs[0];
     let fitted = Tyre::new(res.tyre.clone()).unwrap();
     let noise = RigConfig::standard(&truth, 7).noise;
-    let s_truth = common::combined_sigma_fy(rec, &truth, Some(&noise), 0.0);
-    let s_fit = common::combined_sigma_fy(rec, &fitted, None, 0.0);
+    let s_truth = sigma_fy(rec, &truth, Some(&noise));
+    let s_fit = sigma_fy(rec, &fitted, None);
     // The start, with the data's nominal values as the fit starts from it.
     let mut start_p = TyreParams::builtin();
     tyrekit::fit::mf_fit::nominal_from_data(&mut start_p, &recs).unwrap();
-    let s_start = common::combined_sigma_fy(rec, &Tyre::new(start_p.clone()).unwrap(), None, 0.0);
+    let s_start = sigma_fy(rec, &Tyre::new(start_p.clone()).unwrap(), None);
     println!(
         "σ_Fy on the drive/brake rows: truth {:.2} %, fit {:.2} %, start {:.2} %",
         100.0 * s_truth,

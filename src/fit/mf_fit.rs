@@ -220,9 +220,8 @@ pub fn widen_ranges(tyre: &mut TyreParams, recs: &[Recording]) -> crate::Result<
     Ok(())
 }
 
-/// The range of load, inclination, pressure, slip ratio and slip angle of
-/// every loaded sample of `recs`: where a fitted tyre must be valid
-/// ([`super::validity`]).
+/// The range of load, inclination and pressure of every loaded sample of
+/// `recs`: where a fitted tyre must be valid ([`super::validity`]).
 pub fn data_grid(recs: &[Recording]) -> Grid {
     let span = |f: &dyn Fn(&crate::data::Sample) -> f64| {
         recs.iter()
@@ -239,7 +238,6 @@ pub fn data_grid(recs: &[Recording]) -> Grid {
         span(&|s| s.gamma),
         span(&|s| if s.p > 0.0 { s.p } else { f64::NAN }),
     )
-    .with_slips(span(&|s| s.kappa), span(&|s| s.alpha))
 }
 
 /// Check the hold list of `opts` against the coefficients the stages fit:

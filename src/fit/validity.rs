@@ -7,22 +7,10 @@
 //!   sgn αy = ±1, Et (4.E44) at both ends of its arctangent term (±1: the
 //!   bound holds for every slip angle), Exα (4.E56) and Eyκ (4.E64);
 //! - the friction coefficients μx (4.E13) and μy (4.E23) ≥ [`MU_MIN`] (the
-//!   peak D keeps the sign of the load; use mode 1xx would take |μy|);
-//! - the combined-slip weights stay on the rising branch of their cosine:
-//!   Cyκ·|atan(Byκ·κS − Eyκ(…))| ≤ (π/2)(1 − [`MARGIN`]) (4.E59–4.E65) at
-//!   both ends of the data's slip-ratio range, and the same for Cxα, Bxα,
-//!   αS (4.E51–4.E57) at both ends of its slip-angle range, with B at its
-//!   largest (the cos-atan factor at 1). The ends bound every slip between
-//!   them and the shifted zero (Gyκ0, Gxα0) too, since the ranges hold 0.
-//!   The row binds only C > 1 (`weight_arg`): at C ≤ 1 the weight is a
-//!   cos-atan, positive for every slip.
-//!   So Gyκ, Gxα > 0 wherever the data go: a tyre with RCY1 = 1.39 (real
-//!   files carry it) fits where a bound RCY1 ≤ 1 would make the other
-//!   combined keys compensate; beyond the data a C > 1 turns G negative,
-//!   as it does in the files that have one.
+//!   peak D keeps the sign of the load; use mode 1xx would take |μy|).
 //!
-//! Bounds of single coefficients (C ≥ 0.8, PKY1 < 0 …) stay in the stage
-//! tables; what depends on load, inclination, pressure and the slip range
+//! Bounds of single coefficients (C ≥ 0.8, PKY1 < 0, RCX1, RCY1 ≤ 1 …) stay
+//! in the stage tables; what depends on load, inclination and pressure
 //! together is checked here on a grid spanning the data ([`Grid`]).
 //! Each (condition, grid point) is one residual row
 //! `w · max(0, g(θ) − bound)`: zero while the condition holds, so it does
@@ -47,16 +35,12 @@ pub const MARGIN: f64 = 0.01;
 pub const MU_MIN: f64 = 0.05;
 
 /// The data range the conditions hold on: loads, inclinations (rad) and
-/// pressures (Pa; empty: the file's NOMPRES); the ends of the slip-ratio
-/// range and of tan α (each widened to hold 0; empty: no combined-slip
-/// condition).
+/// pressures (Pa; empty: the file's NOMPRES).
 #[derive(Clone, Debug, Default)]
 pub struct Grid {
     pub fz: Vec<f64>,
     pub gamma: Vec<f64>,
     pub p: Vec<f64>,
-    pub kappa: Vec<f64>,
-    pub tan_alpha: Vec<f64>,
 }
 
 impl Grid {
@@ -64,7 +48,7 @@ impl Grid {
     /// out): 9 loads (E is at most quadratic in the load, so its maximum lies
     /// at an end, at a vertex, or between grid points within a few 1e-3 of
     /// the margin), the inclination's ends and 0 when inside, the
-    /// pressure's ends. Slip ranges are set apart ([`Grid::with_slips`]).
+    /// pressure's ends.
     pub fn spanning(fz: (f64, f64), gamma: (f64, f64), p: (f64, f64)) -> Grid {
         let lin = |(a, b): (f64, f64), n: usize| -> Vec<f64> {
             if !(a.is_finite() && b.is_finite()) || b < a {
@@ -85,23 +69,7 @@ impl Grid {
             fz: lin(fz, 9),
             gamma: g,
             p: lin(p, 2),
-            ..Grid::default()
         }
-    }
-
-    /// The grid with the slip ratio's range `kappa` and the slip angle's
-    /// `alpha` (rad), each widened to hold 0 (non-finite ranges: none).
-    pub fn with_slips(mut self, kappa: (f64, f64), alpha: (f64, f64)) -> Grid {
-        let ends = |(a, b): (f64, f64)| -> Vec<f64> {
-            if a.is_finite() && b.is_finite() && a <= b {
-                vec![a.min(0.0), b.max(0.0)]
-            } else {
-                Vec::new()
-            }
-        };
-        self.kappa = ends(kappa);
-        self.tan_alpha = ends(alpha).into_iter().map(f64::tan).collect();
-        self
     }
 }
 
@@ -115,14 +83,7 @@ enum Kind {
     Eyk,
     MuX,
     MuY,
-    /// Cyκ's cosine argument at the slip ratio κ (an end of the range).
-    Cyk(f64),
-    /// Cxα's cosine argument at α* = tan α (an end of the range).
-    Cxa(f64),
 }
-
-/// Number of keys a condition may depend on.
-const NK: usize = 7;
 
 impl Kind {
     /// The keys g depends on.
@@ -135,12 +96,10 @@ impl Kind {
             Kind::Eyk => &["rey1", "rey2"],
             Kind::MuX => &["pdx1", "pdx2", "ppx3", "ppx4", "pdx3"],
             Kind::MuY => &["pdy1", "pdy2", "ppy3", "ppy4", "pdy3"],
-            Kind::Cyk(_) => &["rcy1", "rby1", "rby4", "rhy1", "rhy2", "rey1", "rey2"],
-            Kind::Cxa(_) => &["rcx1", "rbx1", "rbx3", "rhx1", "rex1", "rex2"],
         }
     }
-    fn all(grid: &Grid) -> Vec<Kind> {
-        let mut kinds = vec![
+    fn all() -> Vec<Kind> {
+        vec![
             Kind::Ex(1.0),
             Kind::Ex(-1.0),
             Kind::Ey(1.0),
@@ -151,10 +110,7 @@ impl Kind {
             Kind::Eyk,
             Kind::MuX,
             Kind::MuY,
-        ];
-        kinds.extend(grid.kappa.iter().map(|&k| Kind::Cyk(k)));
-        kinds.extend(grid.tan_alpha.iter().map(|&a| Kind::Cxa(a)));
-        kinds
+        ]
     }
     fn bound(self) -> f64 {
         match self {
@@ -175,40 +131,8 @@ struct Point {
     gz: f64,
 }
 
-/// The combined-slip weights' condition (4.E51, 4.E59): with
-/// a = |atan(B·s − E·(B·s − atan(B·s)))|·2/π, B = b·λ, s = x + h, the
-/// cosine argument C·a (a share of π/2), less what exceeds the bound at
-/// C = 1 — so the row binds only a C > 1 (cos(atan y) > 0 for every y):
-/// g = C·a − max(0, a − (1 − MARGIN)). Returns g and ∂g/∂(C, b, h, E).
-fn weight_arg(c: f64, b: f64, lam: f64, x: f64, h: f64, e: f64) -> (f64, [f64; 4]) {
-    let s = x + h;
-    let bs = b * lam * s;
-    let y = bs - e * (bs - bs.atan());
-    let sg = if y < 0.0 { -1.0 } else { 1.0 };
-    let k = 2.0 / std::f64::consts::PI;
-    let a = k * sg * y.atan();
-    // da/dy, dy/d(bs) = 1 − E·(1 − 1/(1 + bs²)).
-    let da = k * sg / (1.0 + y * y);
-    let dy = 1.0 - e * (1.0 - 1.0 / (1.0 + bs * bs));
-    let over = a - (1.0 - MARGIN);
-    let (g, f) = if over > 0.0 {
-        (c * a - over, c - 1.0)
-    } else {
-        (c * a, c)
-    };
-    (
-        g,
-        [
-            a,
-            f * da * dy * lam * s,
-            f * da * dy * b * lam,
-            -f * da * (bs - bs.atan()),
-        ],
-    )
-}
-
 /// g(θ) and ∂g/∂key (in the order of [`Kind::keys`]).
-fn eval(kind: Kind, p: &MfParams<f64>, x: &Point) -> (f64, [f64; NK]) {
+fn eval(kind: Kind, p: &MfParams<f64>, x: &Point) -> (f64, [f64; 5]) {
     let d = x.dfz;
     match kind {
         Kind::Ex(s) => {
@@ -217,7 +141,7 @@ fn eval(kind: Kind, p: &MfParams<f64>, x: &Point) -> (f64, [f64; NK]) {
             let l = p.lex;
             (
                 a * b * l,
-                [b * l, d * b * l, d * d * b * l, -s * a * l, 0.0, 0.0, 0.0],
+                [b * l, d * b * l, d * d * b * l, -s * a * l, 0.0],
             )
         }
         Kind::Ey(s) => {
@@ -227,25 +151,17 @@ fn eval(kind: Kind, p: &MfParams<f64>, x: &Point) -> (f64, [f64; NK]) {
             let l = p.ley;
             (
                 a * b * l,
-                [
-                    b * l,
-                    d * b * l,
-                    -s * a * l,
-                    -s * g * a * l,
-                    g * g * a * l,
-                    0.0,
-                    0.0,
-                ],
+                [b * l, d * b * l, -s * a * l, -s * g * a * l, g * g * a * l],
             )
         }
         Kind::Et(u) => {
             let g = x.gz;
             let a = p.qez1 + p.qez2 * d + p.qez3 * d * d;
             let b = 1.0 + (p.qez4 + p.qez5 * g) * u;
-            (a * b, [b, d * b, d * d * b, a * u, a * u * g, 0.0, 0.0])
+            (a * b, [b, d * b, d * d * b, a * u, a * u * g])
         }
-        Kind::Exa => (p.rex1 + p.rex2 * d, [1.0, d, 0.0, 0.0, 0.0, 0.0, 0.0]),
-        Kind::Eyk => (p.rey1 + p.rey2 * d, [1.0, d, 0.0, 0.0, 0.0, 0.0, 0.0]),
+        Kind::Exa => (p.rex1 + p.rex2 * d, [1.0, d, 0.0, 0.0, 0.0]),
+        Kind::Eyk => (p.rey1 + p.rey2 * d, [1.0, d, 0.0, 0.0, 0.0]),
         Kind::MuX | Kind::MuY => {
             let (d1, d2, p3, p4, d3, g, l) = if kind == Kind::MuX {
                 (p.pdx1, p.pdx2, p.ppx3, p.ppx4, p.pdx3, x.gx, p.lmux)
@@ -265,32 +181,8 @@ fn eval(kind: Kind, p: &MfParams<f64>, x: &Point) -> (f64, [f64; NK]) {
                     -a * pi * c * l,
                     -a * pi * pi * c * l,
                     a * b * g * g * l,
-                    0.0,
-                    0.0,
                 ],
             )
-        }
-        Kind::Cyk(kappa) => {
-            // 4.E62 with its cos-atan factor at 1, 4.E64, 4.E65.
-            let g2 = x.gy * x.gy;
-            let b = p.rby1 + p.rby4 * g2;
-            let (v, [dc, db, dh, de]) = weight_arg(
-                p.rcy1,
-                b,
-                p.lyka,
-                kappa,
-                p.rhy1 + p.rhy2 * d,
-                p.rey1 + p.rey2 * d,
-            );
-            (v, [dc, db, db * g2, dh, dh * d, de, de * d])
-        }
-        Kind::Cxa(tan_alpha) => {
-            // 4.E54 with its cos-atan factor at 1, 4.E56, 4.E57.
-            let g2 = x.gx * x.gx;
-            let b = p.rbx1 + p.rbx3 * g2;
-            let (v, [dc, db, dh, de]) =
-                weight_arg(p.rcx1, b, p.lxal, tan_alpha, p.rhx1, p.rex1 + p.rex2 * d);
-            (v, [dc, db, db * g2, dh, de, de * d, 0.0])
         }
     }
 }
@@ -303,7 +195,7 @@ pub struct Validity {
     keys: Vec<usize>,
     base: MfParams<f64>,
     /// (condition, grid point, θ column of each of the condition's keys).
-    rows: Vec<(Kind, Point, [Option<usize>; NK])>,
+    rows: Vec<(Kind, Point, [Option<usize>; 5])>,
     weight: f64,
 }
 
@@ -363,8 +255,8 @@ impl Validity {
             }
         }
         let mut rows = Vec::new();
-        for kind in Kind::all(grid) {
-            let mut cols = [None; NK];
+        for kind in Kind::all() {
+            let mut cols = [None; 5];
             for (k, name) in kind.keys().iter().enumerate() {
                 cols[k] = params
                     .iter()
@@ -476,109 +368,5 @@ impl Problem for Validity {
             p: self.params_at(theta),
             cols: cols.to_vec(),
         }))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::tir::TyreParams;
-
-    fn params(names: &[&str], p: &MfParams<f64>) -> Vec<Param> {
-        names
-            .iter()
-            .map(|n| {
-                let i = crate::tir::keys::key_index(n).unwrap();
-                Param {
-                    name: n.to_string(),
-                    start: p.as_slice()[i],
-                    lower: f64::NEG_INFINITY,
-                    upper: f64::INFINITY,
-                    free: true,
-                }
-            })
-            .collect()
-    }
-
-    fn grid() -> Grid {
-        Grid::spanning((1000.0, 6000.0), (0.0, 0.05), (f64::NAN, f64::NAN))
-            .with_slips((-0.2, 0.2), (-0.1, 0.1))
-    }
-
-    /// The cosine argument of Gyκ against a direct evaluation of 4.E59–4.E65
-    /// (B at its largest: α at RBY3), and the derivatives of both conditions
-    /// against central differences, at a point where every key acts (in both
-    /// branches: inside the margin and beyond it).
-    #[test]
-    fn combined_weight_condition_and_its_derivatives() {
-        let mut p = TyreParams::builtin().p;
-        (p.rcy1, p.rby1, p.rby4, p.rhy1, p.rhy2, p.rey1, p.rey2) =
-            (1.3, 9.0, 20.0, 0.01, -0.02, -0.4, 0.3);
-        (p.rcx1, p.rbx1, p.rbx3, p.rhx1, p.rex1, p.rex2) = (1.2, 12.0, 15.0, 0.005, -0.3, 0.2);
-        let x = Point {
-            dfz: 0.3,
-            dpi: 0.0,
-            gx: 0.05,
-            gy: 0.05,
-            gz: 0.05,
-        };
-        let (g, _) = eval(Kind::Cyk(0.2), &p, &x);
-        let b = (9.0 + 20.0 * 0.0025) * p.lyka;
-        let s = 0.2 + 0.01 - 0.02 * 0.3;
-        let e = -0.4 + 0.3 * 0.3;
-        let y = b * s - e * (b * s - (b * s).atan());
-        let direct = 1.3 * y.atan() / std::f64::consts::FRAC_PI_2;
-        assert!((g - direct).abs() < 1e-14, "{g} vs {direct}");
-        let kinds = [
-            Kind::Cyk(0.2),
-            Kind::Cyk(-0.2),
-            Kind::Cyk(5.0),
-            Kind::Cxa(0.1),
-            Kind::Cxa(-0.1),
-            Kind::Cxa(-8.0),
-        ];
-        for kind in kinds {
-            let (_, dg) = eval(kind, &p, &x);
-            for (k, name) in kind.keys().iter().enumerate() {
-                let i = crate::tir::keys::key_index(name).unwrap();
-                let h = 1e-6 * p.as_slice()[i].abs().max(1e-3);
-                let at = |v: f64| {
-                    let mut q = p.clone();
-                    q.as_mut_slice()[i] = v;
-                    eval(kind, &q, &x).0
-                };
-                let fd = (at(p.as_slice()[i] + h) - at(p.as_slice()[i] - h)) / (2.0 * h);
-                assert!(
-                    (dg[k] - fd).abs() < 1e-6 * fd.abs().max(1.0),
-                    "{kind:?} d/d{name}: {} vs {fd}",
-                    dg[k]
-                );
-            }
-        }
-    }
-
-    /// RCY1 = 1.39 with a moderate Byκ (what real files carry) is valid over
-    /// |κ| ≤ 0.2; the same C with a stiff Byκ (the cosine past its zero at
-    /// κ = 0.2: G < 0 on the data) is not, and C ≤ 1 always is.
-    #[test]
-    fn c_above_one_is_valid_only_where_the_cosine_stays_positive() {
-        let base = TyreParams::builtin().p;
-        let worst = |c: f64, b: f64| {
-            let mut p = base.clone();
-            (p.rcy1, p.rby1, p.rhy1, p.rhy2, p.rey1, p.rey2) = (c, b, 0.0, 0.0, 0.0, 0.0);
-            let names = ["rcy1", "rby1"];
-            let v = Validity::new(Form::Mf6, &p, &params(&names, &p), &grid(), 1.0).unwrap();
-            v.worst(&[c, b]).unwrap()
-        };
-        // 1.39·atan(7·0.2) = 1.31 < π/2.
-        assert!(worst(1.39, 7.0).0 <= 0.0, "{:?}", worst(1.39, 7.0));
-        // 1.39·atan(40·0.2) = 2.01 > π/2: cos < 0 at κ = 0.2.
-        let (over, what) = worst(1.39, 40.0);
-        assert!(over > 0.0 && what.contains("Cyk"), "{over} {what}");
-        // C = 1 is never bound, however steep (cos(atan y) > 0), nor 1.01
-        // where its argument stays inside the margin.
-        assert!(worst(1.0, 200.0).0 <= 0.0);
-        assert!(worst(1.0, 1e5).0 <= 0.0);
-        assert!(worst(1.005, 7.0).0 <= 0.0);
     }
 }

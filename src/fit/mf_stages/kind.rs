@@ -145,16 +145,13 @@ const MZ: &[(&str, f64, f64, bool, bool)] = &[
     ("qhz4", -5.0, 5.0, C, false),
     ("ppz1", -10.0, 10.0, false, P), ("ppz2", -10.0, 10.0, C, P),
 ];
-// RCX1, RCY1 up to 2: what keeps Gxα, Gyκ > 0 is the validity condition on
-// the data's slip range (`fit::validity`, Kind::Cxa/Cyk), not C ≤ 1; real
-// files carry RCY1 = 1.39 and RCX1 = 1.26.
 #[rustfmt::skip]
 const COMBINED: &[(&str, f64, f64, bool, bool)] = &[
     ("rbx1", 0.0, 200.0, false, false), ("rbx2", -200.0, 200.0, false, false),
-    ("rcx1", 0.3, 2.0, false, false), ("rex1", -20.0, 1.0, false, false),
+    ("rcx1", 0.3, 1.0, false, false), ("rex1", -20.0, 1.0, false, false),
     ("rex2", -20.0, 20.0, false, false), ("rhx1", -0.1, 0.1, false, false),
     ("rby1", 0.0, 200.0, false, false), ("rby2", -200.0, 200.0, false, false),
-    ("rby3", -1.0, 1.0, false, false), ("rcy1", 0.3, 2.0, false, false),
+    ("rby3", -1.0, 1.0, false, false), ("rcy1", 0.3, 1.0, false, false),
     ("rey1", -20.0, 1.0, false, false), ("rey2", -20.0, 20.0, false, false),
     ("rhy1", -0.1, 0.1, false, false), ("rhy2", -0.1, 0.1, false, false),
     ("rvy1", -1.0, 1.0, false, false), ("rvy2", -1.0, 1.0, false, false),

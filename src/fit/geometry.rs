@@ -313,11 +313,10 @@ fn fit_re(
                     r.push(-(b * f.fz / fz0).atan() / (1.0 + pfz1 * f.dpi));
                 }
                 // The speed column in the belt speed, not in Ω: at one
-                // belt speed Ω still moves with load (Ω = Vx/Re(Fz)), and
-                // (Ω·R0/V0)² would take up whatever of Re(Fz) the load
-                // terms' form misses as a growth with speed (dev-set r08:
-                // Q_V1 0.0023 from a rig whose radius does not change with
-                // speed, κ off by −0.0008 at 32 km/h and +0.0014 at 48).
+                // belt speed Ω still moves with load (Ω = Vx/Re(Fz)), so
+                // (Ω·R0/V0)² could take up what of Re(Fz) the load terms'
+                // form misses as a growth with speed; the belt speed holds
+                // only the speed levels.
                 if speed {
                     r.push((f.vx / v0).powi(2) - centre);
                 }
@@ -479,7 +478,6 @@ pub fn fit_geometry(tyre: &mut TyreParams, recs: &[Recording]) -> crate::Result<
     });
     // Two belt speeds at least 20 % apart make the speed terms visible.
     let speed = v_hi > 1.2 * v_lo;
-
     let atan = load_levels(&free) >= 3;
     // Pressure spread of 10 % makes the pressure dependence of the
     // deflection (PFZ1) visible in Re: searched on a grid 0…3 (MF files: 0.4–1).

@@ -95,6 +95,16 @@ pub fn model_radii(tyre: &crate::mf::Tyre, fz: f64, re: f64, rl: f64) -> (f64, f
 /// not used.
 pub const SLIP_CHANNEL_RMS: f64 = 3e-3;
 
+/// Number of distinct load levels among loads given as fractions of the
+/// largest (Fz/Fz,max): bins of 5 % of it holding at least 10 samples.
+pub(crate) fn load_levels(fractions: impl Iterator<Item = f64>) -> usize {
+    let mut bins = std::collections::BTreeMap::<i64, usize>::new();
+    for f in fractions {
+        *bins.entry((f / 0.05).round() as i64).or_default() += 1;
+    }
+    bins.values().filter(|&&k| k >= 10).count()
+}
+
 /// Highest degree in load of [`slip_channel_radius`]'s radius.
 const SLIP_RADIUS_MAX_DEGREE: usize = 4;
 
@@ -137,18 +147,18 @@ pub fn slip_channel_radius(samples: &[Sample], sr: &[f64]) -> Option<(Vec<f64>, 
     if fmax <= 0.0 || wmax <= 0.0 {
         return None;
     }
-    let used: Vec<(f64, f64, f64)> = samples
+    let kept: Vec<(&Sample, f64)> = samples
         .iter()
-        .zip(sr)
-        .filter(|(s, &r)| ok(s, r) && s.fz >= 0.05 * fmax)
-        .map(|(s, &r)| (s.fz / fmax, s.omega / wmax, s.vx * (1.0 + r) / s.omega))
+        .zip(sr.iter().copied())
+        .filter(|(s, r)| ok(s, *r) && s.fz >= 0.05 * fmax)
         .collect();
-    let n = used.len();
-    let moving = samples
+    let n = kept.len();
+    let moving = kept.iter().filter(|(_, r)| *r != 0.0).count();
+    // (f, w, R) per sample: load and wheel speed scaled to O(1), the radius.
+    let used: Vec<(f64, f64, f64)> = kept
         .iter()
-        .zip(sr)
-        .filter(|(s, &r)| ok(s, r) && s.fz >= 0.05 * fmax && r != 0.0)
-        .count();
+        .map(|(s, r)| (s.fz / fmax, s.omega / wmax, s.vx * (1.0 + r) / s.omega))
+        .collect();
     if n < 20 || moving < n / 10 {
         return None;
     }
@@ -157,14 +167,7 @@ pub fn slip_channel_radius(samples: &[Sample], sr: &[f64]) -> Option<(Vec<f64>, 
         .fold((f64::INFINITY, f64::NEG_INFINITY), |a, u| {
             (a.0.min(u.0), a.1.max(u.0))
         });
-    // Distinct load levels: 5 %-of-range bins holding at least 10 samples.
-    let levels = {
-        let mut bins = std::collections::BTreeMap::<i64, usize>::new();
-        for u in &used {
-            *bins.entry((u.0 / 0.05).round() as i64).or_default() += 1;
-        }
-        bins.values().filter(|&&k| k >= 10).count()
-    };
+    let levels = load_levels(used.iter().map(|u| u.0));
     // Columns scaled to O(1) for the normal equations: fᵏ, then Ω².
     let row = |f: f64, w: f64, deg: usize| -> nalgebra::DVector<f64> {
         let f = f.clamp(f_lo, f_hi);

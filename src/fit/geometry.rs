@@ -244,17 +244,11 @@ fn lstsq(a: &[Vec<f64>], y: &[f64]) -> Option<Vec<f64>> {
         .then(|| c.iter().copied().collect())
 }
 
-/// Number of distinct load levels (bins of 5 % of the largest load holding
-/// at least 10 samples).
+/// Number of distinct load levels of the free-rolling samples
+/// ([`crate::data::slip::load_levels`]).
 fn load_levels(free: &[Free]) -> usize {
     let fmax = free.iter().map(|f| f.fz).fold(0.0, f64::max);
-    let mut bins = std::collections::BTreeMap::<i64, usize>::new();
-    for f in free {
-        *bins
-            .entry((f.fz / (0.05 * fmax)).round() as i64)
-            .or_default() += 1;
-    }
-    bins.values().filter(|&&n| n >= 10).count()
+    crate::data::slip::load_levels(free.iter().map(|f| f.fz / fmax))
 }
 
 /// Fitted Re model: Re = a + q·(ΩR0/V0)² − cd·atan(B·fzn) − cf·fzn.

@@ -264,3 +264,46 @@ fn continuous_pressure_is_found_and_speed_levels_within_noise_are_not() {
     );
     assert!(f.iter().all(|x| x.name != "speed"), "speed tested");
 }
+
+/// `Finding::share` measures the size of a structure, which significance
+/// does not: on white noise (σ 20 N) every grouping's share stays below
+/// 0.5 % of the squares; a planted load law and a planted sweep-direction
+/// offset each get the share of the squares they add, computed here from
+/// the planted series themselves, within 15 % (the fitted line and r² carry
+/// the noise's chance correlation with them).
+#[test]
+fn a_finding_s_share_is_the_size_of_what_was_planted() {
+    let s = synth();
+    let sq = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>();
+    let pure = noise(s.sim.len(), 20.0, 0.0, 21);
+    for f in run(&s, &pure, 199) {
+        assert!(f.share < 0.005, "noise: {} share {}", f.name, f.share);
+    }
+    // Load: −2 % of the force per nominal load away from 4000 N.
+    let law: Vec<f64> = (0..s.sim.len())
+        .map(|i| -0.02 * (s.fz[i] / 4000.0 - 1.0) * s.sim[i])
+        .collect();
+    let r: Vec<f64> = pure.iter().zip(&law).map(|(a, b)| a + b).collect();
+    let want = sq(&law) / sq(&r);
+    let f = run(&s, &r, 199);
+    let load = f.iter().find(|x| x.name == "load").unwrap();
+    println!("load share {:.4}, planted {want:.4}", load.share);
+    assert!(want > 0.2, "the planted law is no small part: {want}");
+    assert!(
+        (load.share / want - 1.0).abs() < 0.15,
+        "{} vs {want}",
+        load.share
+    );
+    // Sweep direction: +6 N rising, −6 N falling.
+    let hyst: Vec<f64> = s.dir.iter().map(|&d| 6.0 * f64::from(d)).collect();
+    let r: Vec<f64> = pure.iter().zip(&hyst).map(|(a, b)| a + b).collect();
+    let want = sq(&hyst) / sq(&r);
+    let f = run(&s, &r, 199);
+    let dir = f.iter().find(|x| x.name == "sweep_direction").unwrap();
+    println!("direction share {:.4}, planted {want:.4}", dir.share);
+    assert!(
+        (dir.share / want - 1.0).abs() < 0.15,
+        "{} vs {want}",
+        dir.share
+    );
+}

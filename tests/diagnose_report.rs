@@ -286,11 +286,13 @@ fn finding(name: &'static str, groups: &[(&str, f64)]) -> Finding {
         significant: true,
         detail: String::new(),
         groups: groups.iter().map(|(k, v)| (k.to_string(), *v)).collect(),
+        share: 0.3,
     }
 }
 
-/// Significant findings are named with their figures and units; the rest
-/// are not mentioned; nothing significant gives None.
+/// Significant findings are named with their figures, units and size (the
+/// share of the squares); the rest are not mentioned; nothing significant
+/// gives None.
 #[test]
 fn findings_in_words_names_the_signatures() {
     let mut f = vec![
@@ -316,6 +318,7 @@ fn findings_in_words_names_the_signatures() {
     );
     assert!(w.contains("force rate"), "{w}");
     assert!(w.contains("+2.1 % at 2000 N, -3.4 % at 6000 N"), "{w}");
+    assert!(w.contains("at 6000 N) [30 % of its squares]"), "{w}");
     assert!(!w.contains("time in the run"), "{w}");
     assert!(findings_in_words(&f[3..], "N").is_none());
 }

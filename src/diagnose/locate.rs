@@ -119,6 +119,13 @@ pub struct Finding {
     /// residual per region `linear`, `peak`, `sliding` (channel unit);
     /// `sweep_direction` the paired `rising_minus_falling` residual.
     pub groups: Vec<(String, f64)>,
+    /// The share of the channel's residual sum of squares (over the
+    /// segments analysed) that the grouping's structure accounts for — its
+    /// size, where `significant` says only that it is not noise: segment
+    /// groupings the part of the per-segment mean and scale error on the
+    /// least-squares line in the set point, sample groupings the statistic
+    /// (r², R²) times the within-segment share of the squares.
+    pub share: f64,
 }
 
 impl Finding {
@@ -134,7 +141,14 @@ impl Finding {
             significant: false,
             detail,
             groups: Vec::new(),
+            share: f64::NAN,
         }
+    }
+
+    /// With its size (see [`Finding::share`]).
+    fn with_share(mut self, share: f64) -> Finding {
+        self.share = share;
+        self
     }
 
     /// With named figures (see [`Finding::groups`]).
@@ -224,26 +238,74 @@ fn significance(obs: f64, null: &[f64]) -> (f64, f64) {
     (z, (1.0 + ge) / (1.0 + n))
 }
 
-/// Per-segment summaries: (segment index, mean residual, scale error).
-fn segment_values(d: &Residuals) -> Vec<(usize, f64, f64)> {
+/// Per-segment summary of the residual.
+struct SegmentValue {
+    /// Index into the segments.
+    k: usize,
+    /// Mean residual.
+    mean: f64,
+    /// Relative scale error Σ r·F / Σ F².
+    scale: f64,
+    /// Samples used.
+    n: usize,
+    /// Σ F² of the model's force.
+    sff: f64,
+    /// Σ r².
+    srr: f64,
+}
+
+/// Per-segment summaries (segments with at least 10 finite samples).
+fn segment_values(d: &Residuals) -> Vec<SegmentValue> {
     let mut v = Vec::new();
     for (k, g) in d.segments.iter().enumerate() {
-        let (mut sr, mut srf, mut sff, mut n) = (0.0, 0.0, 0.0, 0usize);
+        let (mut sr, mut srf, mut sff, mut srr, mut n) = (0.0, 0.0, 0.0, 0.0, 0usize);
         for i in g.start..g.end.min(d.r.len()) {
             let (r, f) = (d.r[i], d.sim[i]);
             if r.is_finite() && f.is_finite() {
                 sr += r;
                 srf += r * f;
                 sff += f * f;
+                srr += r * r;
                 n += 1;
             }
         }
         if n >= 10 {
-            let b = if sff > 0.0 { srf / sff } else { 0.0 };
-            v.push((k, sr / n as f64, b));
+            let scale = if sff > 0.0 { srf / sff } else { 0.0 };
+            v.push(SegmentValue {
+                k,
+                mean: sr / n as f64,
+                scale,
+                n,
+                sff,
+                srr,
+            });
         }
     }
     v
+}
+
+/// The share of the residual's squares (Σ r² over `sv`) on the
+/// least-squares lines of the segments' mean residual and scale error in
+/// their set point `x`: Σ n·(m̂ − m̄)² + Σ F²·(b̂ − b̄)².
+fn segment_share(sv: &[SegmentValue], x: &[f64]) -> f64 {
+    let m: Vec<f64> = sv.iter().map(|v| v.mean).collect();
+    let b: Vec<f64> = sv.iter().map(|v| v.scale).collect();
+    let (km, kb) = (slope(x, &m), slope(x, &b));
+    let mx = x.iter().sum::<f64>() / x.len().max(1) as f64;
+    let explained: f64 = sv
+        .iter()
+        .zip(x)
+        .map(|(v, &xi)| {
+            let dx = xi - mx;
+            v.n as f64 * (km * dx).powi(2) + v.sff * (kb * dx).powi(2)
+        })
+        .sum();
+    let total: f64 = sv.iter().map(|v| v.srr).sum();
+    if total > 0.0 {
+        explained / total
+    } else {
+        0.0
+    }
 }
 
 /// Most samples the sample-level tests use: longer recordings are thinned by
@@ -268,6 +330,8 @@ struct Within {
     region: Vec<u8>,
     /// Slip value (for the paired hysteresis difference).
     slip: Vec<f64>,
+    /// Σ r² of the samples taken, before the per-segment demeaning.
+    raw_ss: f64,
 }
 
 fn within(d: &Residuals) -> Within {
@@ -280,6 +344,7 @@ fn within(d: &Residuals) -> Within {
         time: vec![],
         region: vec![],
         slip: vec![],
+        raw_ss: 0.0,
     };
     let total: usize = d.segments.iter().map(|g| g.len()).sum();
     let stride = total.div_ceil(MAX_WITHIN).max(1);
@@ -316,6 +381,7 @@ fn within(d: &Residuals) -> Within {
         let mu = idx.iter().map(|&i| d.r[i] * d.sim[i].signum()).sum::<f64>() / idx.len() as f64;
         for (j, &i) in idx.iter().enumerate() {
             let s = d.slip[i];
+            w.raw_ss += d.r[i] * d.r[i];
             w.r.push(d.r[i] - mr);
             w.u.push(d.r[i] * d.sim[i].signum() - mu);
             w.dir.push(f64::from(*d.sweep_dir.get(i).unwrap_or(&0)));
@@ -454,11 +520,11 @@ pub fn locate(d: &Residuals, o: &LocateOptions) -> Vec<Finding> {
         ("speed", &|g| g.vx, Some(|s| s.vx), false),
         ("energy", &mid_energy, None, false),
     ];
-    let m: Vec<f64> = sv.iter().map(|v| v.1).collect();
-    let b: Vec<f64> = sv.iter().map(|v| v.2).collect();
-    let used: Vec<&Segment> = sv.iter().map(|v| &d.segments[v.0]).collect();
+    let m: Vec<f64> = sv.iter().map(|v| v.mean).collect();
+    let b: Vec<f64> = sv.iter().map(|v| v.scale).collect();
+    let used: Vec<&Segment> = sv.iter().map(|v| &d.segments[v.k]).collect();
     for (name, f, get, continuous) in covs {
-        let x: Vec<f64> = sv.iter().map(|v| f(&d.segments[v.0])).collect();
+        let x: Vec<f64> = sv.iter().map(|v| f(&d.segments[v.k])).collect();
         if x.iter().any(|v| !v.is_finite()) {
             continue;
         }
@@ -514,7 +580,8 @@ pub fn locate(d: &Residuals, o: &LocateOptions) -> Vec<Finding> {
                 ("x_max", hi.0),
                 ("scale_at_min", lo.1),
                 ("scale_at_max", hi.1),
-            ]),
+            ])
+            .with_share(segment_share(&sv, &x)),
         );
     }
 
@@ -534,7 +601,13 @@ pub fn locate(d: &Residuals, o: &LocateOptions) -> Vec<Finding> {
                     stat(&buf)
                 })
                 .collect();
-            out.push(Finding::new(name, obs, &null, detail));
+            let within_ss: f64 = y.iter().map(|v| v * v).sum();
+            let share = if w.raw_ss > 0.0 {
+                obs * within_ss / w.raw_ss
+            } else {
+                0.0
+            };
+            out.push(Finding::new(name, obs, &null, detail).with_share(share));
         };
         let region_means = {
             let (mut s, mut n) = ([0.0; 3], [0usize; 3]);

@@ -439,13 +439,20 @@ pub fn diagnose_with(
     let alpha = LocateOptions::default().alpha;
     let in_sample = quality(rec, &base.sim, &extended_sim, &fit_r, &fit_r)?;
     let out_of_sample = quality(rec, &base.sim, &extended_sim, &fit_r, &test_r)?;
-    let mut explanation = explain(&findings, verdict_i.map(|i| &ev[i].0), best_other, alpha);
+    let misfit = misfit_note(&base_fit);
+    let mut explanation = explain(
+        &findings,
+        verdict_i.map(|i| &ev[i].0),
+        best_other,
+        alpha,
+        misfit.is_some() || slip_verdict,
+    );
     // A qualifier another candidate overshadows is not named: say which, and why.
     if let Some(w) = overshadowed_summary(&ev) {
         explanation.push_str(&format!(" {w}"));
     }
     if verdict_i.is_none() && !slip_verdict {
-        if let Some(m) = misfit_note(&base_fit) {
+        if let Some(m) = misfit {
             explanation = format!("{m} {explanation}");
         }
     } else {

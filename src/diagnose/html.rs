@@ -125,23 +125,28 @@ figcaption{{font-size:.9em;color:#444}} details{{margin:1em 0}}\
     }
     s.push_str("</table>\n<p><small>Held-out gain: share of the baseline's squared error (FX, FY, MZ, each over its variance) removed on the segments the candidate was not fitted on (the segments alternate between the halves within each group of kind and load); constant channel offsets are estimated on the fit half and removed. ΔBIC over the whole recording with one effective sample per recorded second (residuals stay correlated over a sweep): negative = the extra parameters pay for themselves.</small></p>\n");
     // Locate.
-    s.push_str("<h2>Where the residual concentrates (baseline)</h2>\n<p><small>Each grouping: a statistic, its permutation p-value (segment-level groupings permute segments; sample-level ones shift each segment's residual circularly, keeping its autocorrelation), Holm-adjusted over the groupings of the channel; significant rows highlighted (family-wise 5 %).</small></p>\n");
+    s.push_str("<h2>Where the residual concentrates (baseline)</h2>\n<p><small>Each grouping: a statistic, its permutation p-value (segment-level groupings permute segments; sample-level ones shift each segment's residual circularly, keeping its autocorrelation), Holm-adjusted over the groupings of the channel; significant rows highlighted (family-wise 5 %). Size: the share of the channel's squared residual the grouping accounts for — significance says the structure is not noise, the size whether it matters (a named effect must remove 2 %).</small></p>\n");
     for (ch, f) in &d.findings {
         let _ = writeln!(
             s,
-            "<h3>{}</h3>\n<table><tr><th>grouping</th><th>statistic</th><th>z</th><th>p</th><th>p (Holm)</th><th>detail</th></tr>",
+            "<h3>{}</h3>\n<table><tr><th>grouping</th><th>statistic</th><th>z</th><th>p</th><th>p (Holm)</th><th>size</th><th>detail</th></tr>",
             ch.name()
         );
         for x in f {
             let _ = writeln!(
                 s,
-                "<tr{}><td>{}</td><td>{:.4}</td><td>{:.1}</td><td>{:.4}</td><td>{:.4}</td><td style=\"text-align:left\">{}</td></tr>",
+                "<tr{}><td>{}</td><td>{:.4}</td><td>{:.1}</td><td>{:.4}</td><td>{:.4}</td><td>{}</td><td style=\"text-align:left\">{}</td></tr>",
                 if x.significant { " class=\"sig\"" } else { "" },
                 x.name,
                 x.statistic,
                 x.z,
                 x.p_value,
                 x.p_adjusted,
+                if x.share.is_finite() {
+                    format!("{:.2} %", 100.0 * x.share)
+                } else {
+                    "–".into()
+                },
                 esc(&x.detail)
             );
         }

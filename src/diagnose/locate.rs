@@ -285,12 +285,10 @@ fn segment_values(d: &Residuals) -> Vec<SegmentValue> {
 }
 
 /// The share of the residual's squares (Σ r² over `sv`) on the
-/// least-squares lines of the segments' mean residual and scale error in
-/// their set point `x`: Σ n·(m̂ − m̄)² + Σ F²·(b̂ − b̄)².
-fn segment_share(sv: &[SegmentValue], x: &[f64]) -> f64 {
-    let m: Vec<f64> = sv.iter().map(|v| v.mean).collect();
-    let b: Vec<f64> = sv.iter().map(|v| v.scale).collect();
-    let (km, kb) = (slope(x, &m), slope(x, &b));
+/// least-squares lines of the segments' mean residuals `m` and scale errors
+/// `b` in their set point `x`: Σ n·(m̂ − m̄)² + Σ F²·(b̂ − b̄)².
+fn segment_share(sv: &[SegmentValue], m: &[f64], b: &[f64], x: &[f64]) -> f64 {
+    let (km, kb) = (slope(x, m), slope(x, b));
     let mx = x.iter().sum::<f64>() / x.len().max(1) as f64;
     let explained: f64 = sv
         .iter()
@@ -581,7 +579,7 @@ pub fn locate(d: &Residuals, o: &LocateOptions) -> Vec<Finding> {
                 ("scale_at_min", lo.1),
                 ("scale_at_max", hi.1),
             ])
-            .with_share(segment_share(&sv, &x)),
+            .with_share(segment_share(&sv, &m, &b, &x)),
         );
     }
 

@@ -125,7 +125,11 @@ figcaption{{font-size:.9em;color:#444}} details{{margin:1em 0}}\
     }
     s.push_str("</table>\n<p><small>Held-out gain: share of the baseline's squared error (FX, FY, MZ, each over its variance) removed on the segments the candidate was not fitted on (the segments alternate between the halves within each group of kind and load); constant channel offsets are estimated on the fit half and removed. ΔBIC over the whole recording with one effective sample per recorded second (residuals stay correlated over a sweep): negative = the extra parameters pay for themselves.</small></p>\n");
     // Locate.
-    s.push_str("<h2>Where the residual concentrates (baseline)</h2>\n<p><small>Each grouping: a statistic, its permutation p-value (segment-level groupings permute segments; sample-level ones shift each segment's residual circularly, keeping its autocorrelation), Holm-adjusted over the groupings of the channel; significant rows highlighted (family-wise 5 %). Size: the share of the channel's squared residual the grouping accounts for — significance says the structure is not noise, the size whether it matters (a named effect must remove 2 %).</small></p>\n");
+    let _ = writeln!(
+        s,
+        "<h2>Where the residual concentrates (baseline)</h2>\n<p><small>Each grouping: a statistic, its permutation p-value (segment-level groupings permute segments; sample-level ones shift each segment's residual circularly, keeping its autocorrelation), Holm-adjusted over the groupings of the channel; significant rows highlighted (family-wise 5 %). Size: the share of the channel's squared residual the grouping accounts for — significance says the structure is not noise, the size whether it matters (a named effect must remove {:.0} %).</small></p>",
+        100.0 * super::candidate::MIN_GAIN
+    );
     for (ch, f) in &d.findings {
         let _ = writeln!(
             s,

@@ -107,6 +107,8 @@ pub(crate) fn load_levels(fractions: impl Iterator<Item = f64>) -> usize {
 
 /// Highest degree in load of [`slip_channel_radius`]'s radius.
 const SLIP_RADIUS_MAX_DEGREE: usize = 4;
+/// Columns of [`slip_channel_radius`]'s least squares: fᵏ up to the degree, Ω².
+const RADIUS_COLUMNS: usize = SLIP_RADIUS_MAX_DEGREE + 2;
 
 /// The radius a recorded slip ratio implies, R = Vx·(1 + SR)/Ω, fitted over
 /// the rolling samples as R = Σₖ cₖ·fᵏ + d·Ω² (f = Fz/Fz,max: a radius that
@@ -168,26 +170,39 @@ pub fn slip_channel_radius(samples: &[Sample], sr: &[f64]) -> Option<(Vec<f64>, 
             (a.0.min(u.0), a.1.max(u.0))
         });
     let levels = load_levels(used.iter().map(|u| u.0));
-    // Columns scaled to O(1) for the normal equations: fᵏ, then Ω².
-    let row = |f: f64, w: f64, deg: usize| -> nalgebra::DVector<f64> {
+    // Columns scaled to O(1) for the normal equations: fᵏ, then Ω². A row
+    // lives on the stack (one per sample and degree, a million samples in a
+    // large recording): its first `deg + 2` entries are used.
+    let row = |f: f64, w: f64, deg: usize| -> [f64; RADIUS_COLUMNS] {
         let f = f.clamp(f_lo, f_hi);
-        let mut v: Vec<f64> = (0..=deg).map(|k| f.powi(k as i32)).collect();
-        v.push(w * w);
-        nalgebra::DVector::from_vec(v)
+        let mut v = [0.0; RADIUS_COLUMNS];
+        for (k, x) in v.iter_mut().enumerate().take(deg + 1) {
+            *x = f.powi(k as i32);
+        }
+        v[deg + 1] = w * w;
+        v
     };
-    let fit_degree = |deg: usize| -> Option<(nalgebra::DVector<f64>, f64)> {
+    let dot =
+        |c: &[f64], a: &[f64; RADIUS_COLUMNS]| c.iter().zip(a).fold(0.0, |s, (c, a)| s + c * a);
+    let fit_degree = |deg: usize| -> Option<(Vec<f64>, f64)> {
         let k = deg + 2;
-        let mut ata = nalgebra::DMatrix::<f64>::zeros(k, k);
-        let mut aty = nalgebra::DVector::<f64>::zeros(k);
+        let mut ata = [[0.0; RADIUS_COLUMNS]; RADIUS_COLUMNS];
+        let mut aty = [0.0; RADIUS_COLUMNS];
         for &(f, w, y) in &used {
             let a = row(f, w, deg);
-            ata += &a * a.transpose();
-            aty += &a * y;
+            for i in 0..k {
+                for j in 0..k {
+                    ata[i][j] += a[i] * a[j];
+                }
+                aty[i] += a[i] * y;
+            }
         }
-        let c = ata.lu().solve(&aty)?;
+        let ata = nalgebra::DMatrix::from_fn(k, k, |i, j| ata[i][j]);
+        let aty = nalgebra::DVector::from_column_slice(&aty[..k]);
+        let c: Vec<f64> = ata.lu().solve(&aty)?.iter().copied().collect();
         let ss: f64 = used
             .iter()
-            .map(|&(f, w, y)| ((c.dot(&row(f, w, deg)) - y) / y).powi(2))
+            .map(|&(f, w, y)| ((dot(&c, &row(f, w, deg)) - y) / y).powi(2))
             .sum();
         (c.iter().all(|x| x.is_finite()) && ss.is_finite()).then_some((c, ss))
     };
@@ -206,7 +221,7 @@ pub fn slip_channel_radius(samples: &[Sample], sr: &[f64]) -> Option<(Vec<f64>, 
         .iter()
         .map(|s| {
             if s.fz.is_finite() && s.omega.is_finite() {
-                c.dot(&row(s.fz / fmax, s.omega / wmax, deg))
+                dot(&c, &row(s.fz / fmax, s.omega / wmax, deg))
             } else {
                 f64::NAN
             }

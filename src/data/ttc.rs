@@ -432,7 +432,7 @@ mod tests {
         let one = parse(&[], 1).unwrap();
         assert_eq!(one[0].len(), 9, "the empty line is skipped");
         assert_eq!(one[1][4], -105.0, "row order kept across the skipped line");
-        for threads in [2, 3, 4, 20] {
+        for threads in [0, 2, 3, 4, 20] {
             assert_eq!(parse(&[], threads).unwrap(), one, "{threads} threads");
         }
     }

@@ -242,30 +242,31 @@ fn parse_rows(
 ) -> Result<Vec<Vec<f64>>> {
     let body = &lines[first..];
     let block = body.len().div_ceil(threads.max(1)).max(1);
+    let mut blocks = body.chunks(block).enumerate();
+    // The first block on this thread (a small file starts none), the others
+    // beside it — as the CSV reader and the `.mat` decoder split their work.
     let parts: Vec<Result<Vec<Vec<f64>>>> = std::thread::scope(|s| {
-        let handles: Vec<_> = body
-            .chunks(block)
-            .enumerate()
+        let head = blocks.next();
+        let rest: Vec<_> = blocks
             .map(|(b, rows)| {
                 s.spawn(move || parse_block(rows, first + b * block, names, tab, file))
             })
             .collect();
-        handles
-            .into_iter()
-            .map(|h| {
-                h.join()
-                    .unwrap_or_else(|_| Err(rerr(file, "data", "a parser thread failed")))
-            })
-            .collect()
+        let mut parts = vec![head.map_or_else(
+            || Ok(vec![Vec::new(); names.len()]),
+            |(_, rows)| parse_block(rows, first, names, tab, file),
+        )];
+        parts.extend(rest.into_iter().map(|h| {
+            h.join()
+                .unwrap_or_else(|_| Err(rerr(file, "data", "a parser thread failed")))
+        }));
+        parts
     });
     let mut parts = parts.into_iter();
-    let mut cols = match parts.next() {
-        Some(p) => p?,
-        None => vec![Vec::new(); names.len()],
-    };
+    let mut cols = parts.next().unwrap_or_else(|| Ok(Vec::new()))?;
     for p in parts {
-        for (c, more) in cols.iter_mut().zip(p?) {
-            c.extend_from_slice(&more);
+        for (c, mut more) in cols.iter_mut().zip(p?) {
+            c.append(&mut more);
         }
     }
     Ok(cols)

@@ -124,6 +124,26 @@ fn check_outputs(rep: &Path) -> serde_json::Value {
         n += 1;
     }
     assert!(n >= 5, "{n} images");
+    // Plots first, tables after (issue #15, item 4), and the first plot is
+    // the evidence against the verdict's own variable: rising against
+    // falling sweeps for a lag, the residual against recorded pressure for
+    // `pressure`, against frictional energy for `thermal`.
+    let first_img = html.find("<img").unwrap();
+    let first_table = html.find("<table").unwrap();
+    assert!(first_img < first_table, "a table comes before the plots");
+    let first = &html[first_img..];
+    let first = &first[first.find("src=\"").unwrap() + 5..];
+    let first = &first[..first.find('"').unwrap()];
+    let expected = match verdict {
+        "relaxation" | "lugre" => Some("hysteresis_"),
+        "pressure" => Some("residual_pressure_"),
+        "thermal" => Some("drift_"),
+        "load_sensitivity" => Some("residual_load_"),
+        _ => None,
+    };
+    if let Some(e) = expected {
+        assert!(first.starts_with(e), "{verdict}: first plot {first}");
+    }
     // Both tyre files load in the library.
     Tyre::from_file(&rep.join("baseline.tir")).unwrap();
     Tyre::from_file(&rep.join("extended.tir")).unwrap();

@@ -1,9 +1,11 @@
 //! html — `DIR/report.html`: one self-contained page (inline CSS, no
 //! scripts, no network) that links the SVG pictures written beside it
-//! ([`super::plots`]): verdict and explanation, the ranked candidates with
-//! their held-out gain, BIC and NRMSE before/after, where the residual
-//! concentrates (the locate statistics per channel), the quality tables in
-//! and out of sample per condition, and the plots with a caption each.
+//! ([`super::plots`]), in the order a tyre engineer reads it: verdict and
+//! explanation, the plots with a caption each (the verdict's own evidence
+//! first), then the tables — the ranked candidates with their held-out
+//! gain, BIC and NRMSE before/after, where the residual concentrates (the
+//! locate statistics per channel), the quality tables in and out of sample
+//! per condition.
 //!
 //! Must never: embed anything from outside the report directory, or let text
 //! from a recording (file names, sources) through unescaped.
@@ -92,6 +94,17 @@ figcaption{{font-size:.9em;color:#444}} details{{margin:1em 0}}\
         ex = esc(d.explanation()),
         bn = esc(baseline_note),
     );
+    // Plots first, the verdict's own evidence leading (their order is
+    // plots::draw_all's); the tables follow.
+    s.push_str("<h2>Plots</h2>\n");
+    for p in plots {
+        let _ = writeln!(
+            s,
+            "<figure><a href=\"{f}\"><img src=\"{f}\" alt=\"{f}\"></a><figcaption>{c}</figcaption></figure>",
+            f = esc(&p.file),
+            c = esc(&p.caption)
+        );
+    }
     // Candidates.
     s.push_str("<h2>Candidates, ranked (verdict first)</h2>\n<table><tr><th>effect</th><th>held-out gain %</th><th>ΔBIC</th><th>parameters</th><th>NRMSE before (FX/FY/MZ) %</th><th>NRMSE after %</th><th>held-out NRMSE before → after (FY) %</th></tr>\n");
     let three = |v: &NrmseMap| {
@@ -166,16 +179,6 @@ before = baseline, after = {} model; each model's constant channel offset (senso
         quality_table(&d.report.quality.out_of_sample),
         quality_table(&d.report.quality.in_sample)
     );
-    // Plots.
-    s.push_str("<h2>Plots</h2>\n");
-    for p in plots {
-        let _ = writeln!(
-            s,
-            "<figure><a href=\"{f}\"><img src=\"{f}\" alt=\"{f}\"></a><figcaption>{c}</figcaption></figure>",
-            f = esc(&p.file),
-            c = esc(&p.caption)
-        );
-    }
     s.push_str("<p><small>Files: diagnosis.json (machine-readable), baseline.tir, extended.tir (load in the FMU or <code>tyrekit replay --tir</code>).");
     if let Some(w) = d.report.extended_parameters_in_words() {
         let _ = write!(

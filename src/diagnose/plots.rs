@@ -15,13 +15,22 @@
 //!   the held-out segments the verdict changes most;
 //! * `residual_pressure_CH.svg` (verdict `pressure` only) — per segment the
 //!   relative force scale error against the segment's mean recorded
-//!   pressure (kPa), baseline and extended: the verdict's own evidence.
-//!
+//!   pressure (kPa), baseline and extended: the verdict's own evidence;
+//! * `residual_speed_CH.svg` (verdict `speed_friction` only) — the same
+//!   against the segment's belt speed (km/h);
+//! * `residual_inclination_CH.svg` (verdict `camber` only) — the same
+//!   against the segment's inclination (degrees);
 //! * `slip_channel.svg` (when the recorded slip ratio disagrees with the
 //!   free-rolling radius, [`super::slip_channel`]) — per load level the
 //!   wheel's own V/Ω, the radius SR was computed with and the baseline's and
 //!   extended file's Re(Fz) in mm; beside it the free-rolling SR read as a
 //!   force, K_x·(SR − mean SR)/Fz in % of Fz: the `rolling_radius` evidence.
+//!
+//!
+//! The list comes back ordered for the reader (issue #15: plots first, the
+//! evidence for the verdict against the verdict's own variable first of
+//! all): the verdict's evidence plots (`evidence_stems`), the channel the
+//! verdict gains most in held out first, then the rest in the order above.
 //!
 //! Must never: draw more than a few thousand points per series (strided),
 //! or fail on a channel the recording lacks (it is skipped).
@@ -227,8 +236,6 @@ impl Chan<'_> {
 /// Draw every picture of the diagnosis into `dir`.
 pub fn draw_all(rec: &Recording, d: &Diagnosis, dir: &Path) -> Result<Vec<Plot>> {
     let mut out = Vec::new();
-    // The verdict's own evidence, drawn first.
-    let mut evidence = Vec::new();
     for ch in Channel::SCORED {
         let (name, unit) = (ch.key(), ch.unit());
         if !channel_present(rec, ch) {
@@ -259,15 +266,68 @@ pub fn draw_all(rec: &Recording, d: &Diagnosis, dir: &Path) -> Result<Vec<Plot>>
         out.push(hysteresis(&c, d.verdict(), dir)?);
         out.push(drift(&c, &d.energy, d.verdict(), dir)?);
         out.push(overlay(&c, d.verdict(), dir)?);
-        if d.verdict() == "pressure" {
-            evidence.push(residual_pressure(&c, d.verdict(), dir)?);
+        match d.verdict() {
+            "pressure" => out.push(residual_pressure(&c, d.verdict(), dir)?),
+            "speed_friction" => out.push(residual_speed(&c, d.verdict(), dir)?),
+            "camber" => out.push(residual_inclination(&c, d.verdict(), dir)?),
+            _ => {}
         }
     }
     if let Some(sc) = d.report.slip_channel.as_ref().filter(|s| s.found) {
-        evidence.insert(0, slip_channel(sc, dir)?);
+        out.push(slip_channel(sc, dir)?);
     }
-    evidence.extend(out);
-    Ok(evidence)
+    // The verdict's channels by its held-out gain, best first.
+    let gain = |ch: &str| {
+        d.report
+            .effects
+            .iter()
+            .find(|e| e.name == d.verdict())
+            .and_then(|e| e.channels.iter().find(|c| c.channel.key() == ch))
+            .map_or(f64::NEG_INFINITY, |c| c.oos_gain)
+    };
+    Ok(reader_order(out, evidence_stems(d.verdict()), gain))
+}
+
+/// The file-name stems of the plots that show `verdict`'s own evidence,
+/// most telling first: the residual against the verdict's own variable
+/// (pressure, belt speed, inclination, load), rising against falling
+/// sweeps for a lag, drift against frictional energy for a temperature
+/// state, the free-rolling slip for a radius.
+pub(crate) fn evidence_stems(verdict: &str) -> &'static [&'static str] {
+    match verdict {
+        "pressure" => &["residual_pressure"],
+        "speed_friction" => &["residual_speed", "residual_slip"],
+        "camber" => &["residual_inclination"],
+        "load_sensitivity" => &["residual_load"],
+        "relaxation" | "lugre" => &["hysteresis"],
+        "thermal" => &["drift"],
+        "rolling_radius" => &["slip_channel"],
+        _ => &[],
+    }
+}
+
+/// `plots` reordered for the reader: those whose file starts with one of
+/// `stems` first (by stem, then by `gain` of their channel, highest first),
+/// then the others in the order drawn. Stable.
+fn reader_order(plots: Vec<Plot>, stems: &[&str], gain: impl Fn(&str) -> f64) -> Vec<Plot> {
+    let rank = |p: &Plot| {
+        stems
+            .iter()
+            .position(|s| p.file.starts_with(s))
+            .unwrap_or(stems.len())
+    };
+    let mut evidence: Vec<Plot> = plots
+        .iter()
+        .filter(|p| rank(p) < stems.len())
+        .cloned()
+        .collect();
+    evidence.sort_by(|a, b| {
+        rank(a)
+            .cmp(&rank(b))
+            .then(gain(b.channel).total_cmp(&gain(a.channel)))
+    });
+    evidence.extend(plots.into_iter().filter(|p| rank(p) == stems.len()));
+    evidence
 }
 
 /// The rolling-radius evidence from the data channels (see the module docs).
@@ -554,6 +614,40 @@ fn residual_pressure(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
     )
 }
 
+/// Per segment the relative force scale error against the belt speed
+/// (km/h): the evidence of a `speed_friction` verdict across belt speeds.
+fn residual_speed(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
+    segment_scale_plot(
+        c,
+        verdict,
+        dir,
+        &SegmentAxis {
+            stem: "residual_speed",
+            what: "belt speed",
+            label: "belt speed (segment mean) [km/h]",
+            x: |_, g| 3.6 * g.vx,
+            look_for: "the belt speed: friction that falls with sliding speed leaves the faster segments weaker than the baseline; the extended model should flatten the trend.",
+        },
+    )
+}
+
+/// Per segment the relative force scale error against the inclination
+/// (degrees): the evidence of a `camber` verdict.
+fn residual_inclination(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
+    segment_scale_plot(
+        c,
+        verdict,
+        dir,
+        &SegmentAxis {
+            stem: "residual_inclination",
+            what: "inclination",
+            label: "inclination angle [deg]",
+            x: |_, g| g.gamma.to_degrees(),
+            look_for: "the inclination angle: a trend is camber acting on the force differently from the model; the extended model should flatten it.",
+        },
+    )
+}
+
 /// Mean of y per x bin over `idx`, rising and falling sweeps apart.
 fn binned(c: &Chan, idx: &[usize], y: &dyn Fn(usize) -> f64) -> (Curve, Curve) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -817,4 +911,80 @@ fn overlay(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
             c.ch.name()
         ),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{evidence_stems, reader_order, Plot};
+
+    fn plot(file: &str, channel: &'static str) -> Plot {
+        Plot {
+            file: file.into(),
+            channel,
+            caption: String::new(),
+        }
+    }
+
+    fn files(v: &[Plot]) -> Vec<&str> {
+        v.iter().map(|p| p.file.as_str()).collect()
+    }
+
+    /// Drawn per channel in the fixed order; read with the verdict's own
+    /// evidence first, its best channel leading, the rest as drawn.
+    #[test]
+    fn the_verdict_s_evidence_leads_its_best_channel_first() {
+        let drawn = || {
+            let mut v = Vec::new();
+            for ch in ["FX", "FY", "MZ"] {
+                for stem in ["residual_slip", "residual_load", "hysteresis", "drift"] {
+                    v.push(plot(&format!("{stem}_{}.svg", ch.to_lowercase()), ch));
+                }
+            }
+            v
+        };
+        // Mz gains most, then Fx; Fy not scored.
+        let gain = |ch: &str| match ch {
+            "MZ" => 0.20,
+            "FX" => 0.05,
+            _ => f64::NEG_INFINITY,
+        };
+        let v = reader_order(drawn(), evidence_stems("relaxation"), gain);
+        assert_eq!(
+            files(&v)[..4],
+            [
+                "hysteresis_mz.svg",
+                "hysteresis_fx.svg",
+                "hysteresis_fy.svg",
+                "residual_slip_fx.svg"
+            ]
+        );
+        assert_eq!(v.len(), 12);
+        let v = reader_order(drawn(), evidence_stems("thermal"), gain);
+        assert_eq!(files(&v)[0], "drift_mz.svg");
+        // Two stems: by stem first, then by gain.
+        let mut d = drawn();
+        d.push(plot("residual_speed_fx.svg", "FX"));
+        let v = reader_order(d, evidence_stems("speed_friction"), gain);
+        assert_eq!(
+            files(&v)[..3],
+            [
+                "residual_speed_fx.svg",
+                "residual_slip_mz.svg",
+                "residual_slip_fx.svg"
+            ]
+        );
+        // No verdict: the drawing order stands.
+        let v = reader_order(drawn(), evidence_stems("none"), gain);
+        assert_eq!(files(&v), files(&drawn()));
+    }
+
+    /// Every candidate the diagnosis can name has evidence to show first.
+    #[test]
+    fn every_named_effect_has_its_evidence() {
+        let all = crate::diagnose::candidate::all();
+        assert!(all.len() >= 8);
+        for c in all.iter().filter(|c| c.name() != "none") {
+            assert!(!evidence_stems(c.name()).is_empty(), "{}", c.name());
+        }
+    }
 }

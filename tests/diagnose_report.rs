@@ -180,6 +180,28 @@ fn no_tir_on_rig_recording() {
         .as_f64()
         .unwrap();
     assert!(fy < 0.10, "fitted baseline FY σ {fy}");
+    // Fy–α per load (issue #15, item 4): one overlay panel per load level of
+    // the programme, lightest first, titled in kN.
+    let svg = std::fs::read_to_string(rep.join("overlay_fy.svg")).unwrap();
+    let loads: Vec<f64> = svg
+        .split("Fz ")
+        .skip(1)
+        .filter_map(|t| t.split(" kN").next()?.parse().ok())
+        .collect();
+    assert_eq!(loads.len(), cfg.programme.loads.len(), "panels {loads:?}");
+    assert!(loads.windows(2).all(|w| w[0] < w[1]), "{loads:?}");
+    let mut want: Vec<f64> = cfg.programme.loads.iter().map(|f| f / 1e3).collect();
+    want.sort_by(f64::total_cmp);
+    for (got, want) in loads.iter().zip(&want) {
+        assert!(
+            (got - want).abs() < 0.05 * want,
+            "{loads:?} against {want:?}"
+        );
+    }
+    // Before/after per condition, once something is named.
+    if j["verdict"] != "none" {
+        assert!(rep.join("before_after_fy.svg").is_file());
+    }
     // The baseline holds what the candidates own: no pressure terms.
     let base = Tyre::from_file(&rep.join("baseline.tir")).unwrap();
     assert_eq!(base.params().p.ppy1, 0.0);
@@ -347,6 +369,7 @@ fn row(channel: &str, before: f64, after: f64) -> QualityRow {
     QualityRow {
         channel: Channel::parse(channel).expect("a channel name"),
         condition: "all".into(),
+        fz: None,
         n: 1000,
         sigma_before: before,
         sigma_after: after,

@@ -11,8 +11,13 @@
 //! * `drift_CH.svg` — the signed residual (+ = measured stronger) against
 //!   time in the run and per segment against the accumulated frictional
 //!   energy: a temperature or wear state drifts;
-//! * `overlay_CH.svg` — measured, baseline and extended model against slip on
-//!   the held-out segments the verdict changes most;
+//! * `overlay_CH.svg` — measured, baseline and extended model against slip
+//!   (Fy–α, Mz–α, Fx–κ) per load level, lightest first: at each level the
+//!   held-out segment the verdict changes most (a fitted one, marked, where
+//!   the level has none held out);
+//! * `before_after_CH.svg` (a verdict other than `none`) — per condition of
+//!   the held-out half (load, inclination, pressure) the NRMSE of the
+//!   baseline and of the extended model against the load in kN;
 //! * `residual_pressure_CH.svg` (verdict `pressure` only) — per segment the
 //!   relative force scale error against the segment's mean recorded
 //!   pressure (kPa), baseline and extended: the verdict's own evidence;
@@ -169,12 +174,95 @@ type Curve = Vec<(f64, f64)>;
 
 /// A figure of `cols` panels side by side.
 fn figure(path: &Path, cols: usize, draw: &dyn Fn(&Areas) -> Result<()>) -> Result<()> {
-    let root = SVGBackend::new(path, (560 * cols as u32, 440)).into_drawing_area();
+    figure_grid(path, 1, cols, draw)
+}
+
+/// A figure of `rows` × `cols` panels, filled row by row.
+fn figure_grid(
+    path: &Path,
+    rows: usize,
+    cols: usize,
+    draw: &dyn Fn(&Areas) -> Result<()>,
+) -> Result<()> {
+    let size = (560 * cols as u32, 440 * rows as u32);
+    let root = SVGBackend::new(path, size).into_drawing_area();
     root.fill(&WHITE).map_err(|e| perr(path, e))?;
-    let areas = root.split_evenly((1, cols));
+    let areas = root.split_evenly((rows, cols));
     draw(&areas)?;
     root.present().map_err(|e| perr(path, e))?;
     Ok(())
+}
+
+/// `x` rounded to a tenth, without a negative zero ("-0.0°").
+fn tenth(x: f64) -> f64 {
+    (x * 10.0).round() / 10.0 + 0.0
+}
+
+/// Per condition (load, inclination, pressure) the held-out NRMSE of the
+/// baseline and of the extended model against the condition's load in kN:
+/// the before/after of the verdict per condition, drawn from the quality
+/// table's held-out rows. `None` when the channel has no condition rows.
+fn before_after(
+    rows: &[super::report::QualityRow],
+    c: &Chan,
+    verdict: &str,
+    dir: &Path,
+) -> Result<Option<Plot>> {
+    let pts = |after: bool| -> Curve {
+        rows.iter()
+            .filter(|r| r.channel == c.ch)
+            .filter_map(|r| {
+                let v = if after { r.nrmse_after } else { r.nrmse_before };
+                r.fz.map(|fz| (fz / 1e3, 100.0 * v))
+            })
+            .filter(|p| p.0.is_finite() && p.1.is_finite())
+            .collect()
+    };
+    let (b, a) = (pts(false), pts(true));
+    if b.is_empty() {
+        return Ok(None);
+    }
+    let file = format!("before_after_{}.svg", c.name.to_lowercase());
+    let path = dir.join(&file);
+    let lo = b
+        .iter()
+        .chain(&a)
+        .map(|p| p.1)
+        .fold(f64::INFINITY, f64::min);
+    let hi = b.iter().chain(&a).map(|p| p.1).fold(0.0, f64::max);
+    let yr = (0.0f64.min(lo), 1.05 * hi);
+    figure(&path, 1, &|ar| {
+        panel(
+            &ar[0],
+            &path,
+            &format!("{} held-out NRMSE per condition", c.ch.name()),
+            "Fz (condition) [kN]",
+            "NRMSE [%]",
+            &[
+                Series::Points(b.clone(), BASE, "baseline".into(), 4),
+                Series::Points(a.clone(), EXT, after_label(verdict), 3),
+            ],
+            Some(yr),
+        )
+    })?;
+    Ok(Some(Plot {
+        file,
+        channel: c.name,
+        caption: format!(
+            "Before and after per condition: each load, inclination and pressure of the held-out half, the {} NRMSE of the baseline (blue) and of the extended model (red) against the load; red below blue is where the verdict helps.",
+            c.ch.name()
+        ),
+    }))
+}
+
+/// Most panels of the per-load overlay (a programme has 3–6 load levels).
+const MAX_PANELS: usize = 6;
+
+/// Whether two segment loads (N) are one load level: within 10 % of the
+/// larger (set points of a programme differ by ≥ 30 %; load control holds
+/// a level within a few %).
+fn same_level(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 0.1 * a.abs().max(b.abs())
 }
 
 /// Common y range of several point sets (robust: 0.5 % / 99.5 % quantiles,
@@ -266,6 +354,11 @@ pub fn draw_all(rec: &Recording, d: &Diagnosis, dir: &Path) -> Result<Vec<Plot>>
         out.push(hysteresis(&c, d.verdict(), dir)?);
         out.push(drift(&c, &d.energy, d.verdict(), dir)?);
         out.push(overlay(&c, d.verdict(), dir)?);
+        if d.verdict() != "none" {
+            if let Some(p) = before_after(&d.report.quality.out_of_sample, &c, d.verdict(), dir)? {
+                out.push(p);
+            }
+        }
         match d.verdict() {
             "pressure" => out.push(residual_pressure(&c, d.verdict(), dir)?),
             "speed_friction" => out.push(residual_speed(&c, d.verdict(), dir)?),
@@ -831,9 +924,9 @@ fn drift(c: &Chan, energy: &[f64], verdict: &str, dir: &Path) -> Result<Plot> {
 fn overlay(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
     let file = format!("overlay_{}.svg", c.name.to_lowercase());
     let path = dir.join(&file);
-    let (_, test) = split(c.rec);
-    // Held-out segments ranked by the change the verdict makes (or by the
-    // baseline's error when it changes nothing).
+    let (_, held_out) = super::candidate::split(c.rec);
+    // Segments ranked by the change the verdict makes (or by the baseline's
+    // error when it changes nothing), held-out ones before fitted ones.
     let sse = |r: &std::ops::Range<usize>, after: bool| {
         r.clone()
             .map(|i| c.r(i, after))
@@ -841,31 +934,50 @@ fn overlay(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
             .map(|v| v * v)
             .sum::<f64>()
     };
-    let mut ranked: Vec<(f64, std::ops::Range<usize>)> = test
+    let finite =
+        |r: &std::ops::Range<usize>| r.clone().filter(|&i| c.r(i, false).is_finite()).count();
+    let n = c.meas.len();
+    let mut ranked: Vec<(bool, f64, f64, std::ops::Range<usize>)> = c
+        .rec
+        .segments
         .iter()
-        .filter(|r| r.len() >= 10)
-        .map(|r| {
+        .map(|g| (g, g.start.min(n)..g.end.min(n)))
+        .filter(|(_, r)| finite(r) >= 10)
+        .map(|(g, r)| {
             let key = if verdict == "none" {
-                sse(r, false)
+                sse(&r, false)
             } else {
-                sse(r, false) - sse(r, true)
+                sse(&r, false) - sse(&r, true)
             };
-            (key, r.clone())
+            (held_out.get(r.start) == Some(&true), key, g.fz, r)
         })
         .collect();
-    ranked.sort_by(|a, b| b.0.total_cmp(&a.0));
-    ranked.truncate(3);
+    ranked.sort_by(|a, b| b.0.cmp(&a.0).then(b.1.total_cmp(&a.1)));
+    // One panel per load level (the level's held-out segment the verdict
+    // changes most; a fitted one where the level has none held out),
+    // lightest load first: the curves per load.
+    let mut panels: Vec<(f64, bool, std::ops::Range<usize>)> = Vec::new();
+    for (out, _, fz, r) in &ranked {
+        if !panels.iter().any(|(l, ..)| same_level(*l, *fz)) {
+            panels.push((*fz, *out, r.clone()));
+        }
+    }
+    panels.truncate(MAX_PANELS);
+    panels.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut ranked: Vec<(bool, std::ops::Range<usize>)> =
+        panels.into_iter().map(|(_, out, r)| (out, r)).collect();
     if ranked.is_empty() {
         ranked = split(c.rec)
             .0
             .into_iter()
             .take(1)
-            .map(|r| (0.0, r))
+            .map(|r| (false, r))
             .collect();
     }
-    let cols = ranked.len().max(1);
-    figure(&path, cols, &|a| {
-        for (k, (_, r)) in ranked.iter().enumerate() {
+    let cols = ranked.len().clamp(1, 3);
+    let rows = ranked.len().max(1).div_ceil(cols);
+    figure_grid(&path, rows, cols, &|a| {
+        for (k, (out, r)) in ranked.iter().enumerate() {
             let stride = (r.len() / 1500).max(1);
             let line = |v: &[f64]| -> Vec<(f64, f64)> {
                 r.clone()
@@ -877,11 +989,12 @@ fn overlay(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
             let g = c.rec.segments.iter().find(|g| g.start == r.start);
             let title = g.map_or("segment".into(), |g| {
                 format!(
-                    "Fz {:.0} N, γ {:.1}°, p {:.0} kPa, {:.1} m/s",
-                    g.fz,
-                    g.gamma.to_degrees(),
+                    "Fz {:.2} kN, γ {:.1}°, {:.0} kPa, {:.0} km/h{}",
+                    g.fz / 1e3,
+                    tenth(g.gamma.to_degrees()),
                     g.p / 1e3,
-                    g.vx
+                    3.6 * g.vx,
+                    if *out { "" } else { " (fit half)" }
                 )
             });
             let mut series = vec![
@@ -907,7 +1020,7 @@ fn overlay(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
         file,
         channel: c.name,
         caption: format!(
-            "Measured (grey), baseline (blue) and extended model (red) {} on the held-out segments the verdict changes most (segments the candidates were not fitted on).",
+            "Measured (grey), baseline (blue) and extended model (red) {} per load, lightest first: at each load level the held-out segment (not fitted by the candidates) the verdict changes most, or a fitted one (marked) where the level has none held out.",
             c.ch.name()
         ),
     })

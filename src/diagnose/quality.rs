@@ -63,6 +63,9 @@ pub struct QualityRow {
     pub channel: Channel,
     /// "all", "Fz 4000 N, γ 0.0°, p 220 kPa" or "Vx 16.2 m/s".
     pub condition: String,
+    /// The condition's load (N) for a load/inclination/pressure condition;
+    /// `None` for "all" and the per-speed rows.
+    pub fz: Option<f64>,
     pub n: usize,
     pub sigma_before: f64,
     pub sigma_after: f64,
@@ -121,6 +124,7 @@ pub fn quality(
                         c.p / 1e3
                     )
                 }),
+                fz: b.condition.as_ref().map(|c| c.fz),
                 n: b.n,
                 sigma_before: b.sigma,
                 sigma_after: a.sigma,
@@ -157,6 +161,7 @@ pub fn quality(
                     rows.push(QualityRow {
                         channel: ch,
                         condition: format!("Vx {v:.1} m/s"),
+                        fz: None,
                         n: yy.iter().filter(|x| x.is_finite()).count(),
                         sigma_before: sigma(&pb, &yy),
                         sigma_after: sigma(&pa, &yy),

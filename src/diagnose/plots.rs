@@ -258,6 +258,21 @@ fn before_after(
 /// Most panels of the per-load overlay (a programme has 3–6 load levels).
 const MAX_PANELS: usize = 6;
 
+/// The load levels (N) of a programme's segment loads, lightest first: a
+/// new level where a load is not [`same_level`] as the last level's first
+/// load; each level its first (lightest) load.
+fn load_levels(fz: impl Iterator<Item = f64>) -> Vec<f64> {
+    let mut v: Vec<f64> = fz.filter(|x| x.is_finite()).collect();
+    v.sort_by(f64::total_cmp);
+    let mut levels: Vec<f64> = Vec::new();
+    for x in v {
+        if levels.last().is_none_or(|&l| !same_level(l, x)) {
+            levels.push(x);
+        }
+    }
+    levels
+}
+
 /// Whether two segment loads (N) are one load level: within 10 % of the
 /// larger (set points of a programme differ by ≥ 30 %; load control holds
 /// a level within a few %).
@@ -518,14 +533,8 @@ fn residual_slip(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
     let file = format!("residual_slip_{}.svg", c.name.to_lowercase());
     let path = dir.join(&file);
     let idx = c.inside(MAX_POINTS);
-    let mut loads: Vec<i64> = c
-        .rec
-        .segments
-        .iter()
-        .map(|g| (g.fz / 10.0).round() as i64)
-        .collect();
-    loads.sort();
-    loads.dedup();
+    let loads = load_levels(c.rec.segments.iter().map(|g| g.fz));
+    let level_of = |fz: f64| loads.iter().position(|&l| same_level(l, fz));
     let seg_of = segment_index(c.rec);
     let series = |after: bool| -> Vec<Series> {
         loads
@@ -535,12 +544,12 @@ fn residual_slip(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
                 let pts: Vec<(f64, f64)> = idx
                     .iter()
                     .filter(|&&i| {
-                        seg_of[i].is_some_and(|k| (c.rec.segments[k].fz / 10.0).round() as i64 == l)
+                        seg_of[i].is_some_and(|k| level_of(c.rec.segments[k].fz) == Some(li))
                     })
                     .map(|&i| (c.slip_deg(i), c.r(i, after)))
                     .collect();
                 let (r, g, b) = Palette99::pick(li).to_rgba().rgb();
-                Series::Points(pts, RGBColor(r, g, b), format!("Fz {} N", l * 10), 1)
+                Series::Points(pts, RGBColor(r, g, b), format!("Fz {:.2} kN", l / 1e3), 1)
             })
             .collect()
     };
@@ -682,8 +691,8 @@ fn residual_load(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
         &SegmentAxis {
             stem: "residual_load",
             what: "load",
-            label: "Fz [N]",
-            x: |_, g| g.fz,
+            label: "Fz [kN]",
+            x: |_, g| g.fz / 1e3,
             look_for: "load: a trend with load is a load-sensitivity error, scatter between segments at one load a pressure, speed or temperature effect.",
         },
     )
@@ -1089,6 +1098,29 @@ mod tests {
         // No verdict: the drawing order stands.
         let v = reader_order(drawn(), evidence_stems("none"), gain);
         assert_eq!(files(&v), files(&drawn()));
+    }
+
+    /// Load-controlled set points a few newtons apart are one level; the
+    /// programme's set points (≥ 30 % apart) are not.
+    #[test]
+    fn load_levels_merge_a_set_point_s_scatter() {
+        let l = super::load_levels(
+            [
+                1556.0,
+                667.0,
+                222.0,
+                1111.0,
+                445.0,
+                1561.0,
+                449.0,
+                331.0,
+                226.0,
+                f64::NAN,
+            ]
+            .into_iter(),
+        );
+        assert_eq!(l, [222.0, 331.0, 445.0, 667.0, 1111.0, 1556.0]);
+        assert!(super::load_levels(std::iter::empty()).is_empty());
     }
 
     /// Every candidate the diagnosis can name has evidence to show first.

@@ -61,7 +61,7 @@ pub(crate) fn ranges(mask: &[bool]) -> Vec<Range<usize>> {
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct QualityRow {
     pub channel: Channel,
-    /// "all", "Fz 4000 N, γ 0.0°, p 220 kPa" or "Vx 16.2 m/s".
+    /// "all", "Fz 4000 N, γ 0.0°, p 220 kPa" or "Vx 58 km/h".
     pub condition: String,
     /// The condition's load (N) for a load/inclination/pressure condition;
     /// `None` for "all" and the per-speed rows.
@@ -120,7 +120,7 @@ pub fn quality(
                     format!(
                         "Fz {:.0} N, γ {:.1}°, p {:.0} kPa",
                         c.fz,
-                        c.gamma.to_degrees(),
+                        (c.gamma.to_degrees() * 10.0).round() / 10.0 + 0.0,
                         c.p / 1e3
                     )
                 }),
@@ -160,7 +160,7 @@ pub fn quality(
                 if !yy.is_empty() {
                     rows.push(QualityRow {
                         channel: ch,
-                        condition: format!("Vx {v:.1} m/s"),
+                        condition: format!("Vx {:.0} km/h", 3.6 * v),
                         fz: None,
                         n: yy.iter().filter(|x| x.is_finite()).count(),
                         sigma_before: sigma(&pb, &yy),

@@ -103,6 +103,12 @@ fn mode() -> UseMode {
 /// recorded pressure following the saw-tooth (plus 0.1 kPa sensor noise)
 /// and 12 N / 0.4 N·m white noise on the forces (the rig's default levels).
 fn recording(tyre: &Tyre, law: Law) -> Recording {
+    recording_rising_over(tyre, law, RISE)
+}
+
+/// [`recording`] with one rise of the pressure lasting `rise` of the
+/// programme's duration (> 1: it rises through the whole run, never let down).
+fn recording_rising_over(tyre: &Tyre, law: Law, rise: f64) -> Recording {
     let mut cfg = RigConfig::standard(tyre, 23);
     cfg.noise = Noise::none();
     let pr = &mut cfg.programme;
@@ -125,7 +131,7 @@ fn recording(tyre: &Tyre, law: Law) -> Recording {
         .last()
         .map_or(600.0, |s| s.time);
     m.law = law;
-    m.period = RISE * duration;
+    m.period = rise * duration;
     let run = simulate(&cfg, &mut m);
     let mut rng = ChaCha8Rng::seed_from_u64(7);
     let mut g = || {
@@ -265,6 +271,37 @@ fn drifting_pressure_without_a_law_is_none() {
     let d = diagnose(&recording(&tyre, Law::None), &tyre, &opts()).unwrap();
     show(&d);
     assert_eq!(d.verdict(), "none");
+    // Let down once: pressure and time are told apart, nothing to qualify.
+    assert!(
+        !d.explanation()
+            .contains("cannot be told from any other slow drift"),
+        "{}",
+        d.explanation()
+    );
+}
+
+/// A pressure that only rises through the run (a warming tyre never let
+/// down) cannot be told from any other slow drift: with no law in the
+/// forces the verdict stays `none`, but the words must not claim that
+/// nothing is missing without saying what the recording cannot separate.
+#[test]
+fn a_pressure_rising_through_the_run_qualifies_nothing_missing() {
+    let tyre = Tyre::builtin();
+    let d = diagnose(
+        &recording_rising_over(&tyre, Law::None, 1.2),
+        &tyre,
+        &opts(),
+    )
+    .unwrap();
+    show(&d);
+    assert_eq!(d.verdict(), "none");
+    let e = d.explanation();
+    assert!(!e.starts_with("Nothing is missing:"), "{e}");
+    assert!(
+        e.contains("cannot be told from any other slow drift"),
+        "{e}"
+    );
+    assert!(e.contains("rises"), "{e}");
 }
 
 /// Each channel's BIC charges the pressure terms that can move it

@@ -139,13 +139,17 @@ fn set_point(grouping: &str, x: f64) -> String {
 /// The explanation of the verdict (see the module docs). `not_clean`: the
 /// baseline misfits (a channel above [`super::misfit::MISFIT_RATIO`] × its
 /// noise floor) or another check names a finding (the slip channel), so
-/// that "nothing is missing" must not be said.
+/// that "nothing is missing" must not be said. `unseparable`: a condition
+/// that varies with time in the run alone (`time_drift_in_words`); with
+/// no verdict, "nothing is missing" is then said only of what the
+/// recording can tell apart, and the words say what it cannot.
 pub fn explain(
     findings: &[(Channel, Vec<Finding>)],
     verdict: Option<&Evaluation>,
     best_other: Option<&Evaluation>,
     alpha: f64,
     not_clean: bool,
+    unseparable: Option<&str>,
 ) -> String {
     let small = !not_clean && findings.iter().all(|(_, f)| !f.iter().any(material));
     let mut where_ = Vec::new();
@@ -183,22 +187,48 @@ pub fn explain(
                     why_not(b).unwrap_or_default()
                 )
             });
-            match located {
+            let nothing = if unseparable.is_some() {
+                "Nothing is missing that this recording can tell apart"
+            } else {
+                "Nothing is missing"
+            };
+            let words = match located {
                 None => format!(
-                    "Nothing is missing: the residual is noise (no grouping significant at {:.0} % family-wise) and {best}.",
+                    "{nothing}: the residual is noise (no grouping significant at {:.0} % family-wise) and {best}.",
                     100.0 * alpha
                 ),
                 Some(w) if small => format!(
-                    "Nothing is missing: the structure the residual shows is real but small — {w} — each part under the {:.0} % of its channel's squares that a candidate must remove to be named, and {best}.",
+                    "{nothing}: the structure the residual shows is real but small — {w} — each part under the {:.0} % of its channel's squares that a candidate must remove to be named, and {best}.",
                     100.0 * MIN_GAIN
                 ),
                 Some(w) => format!(
                     "{}, but none of the candidates explains it: {best}. The structure is real but lies outside the candidate physics (or in the baseline's own fit).",
                     capitalise(&w)
                 ),
+            };
+            match unseparable {
+                Some(u) => format!("{words} {}", capitalise(u)),
+                None => words,
             }
         }
     }
+}
+
+/// What a recording cannot tell apart, in words: the recorded inflation
+/// pressure that rises (or falls) with the run alone (`factor::drift_with_time`):
+/// a dependence on it is then indistinguishable from any other slow drift.
+pub fn time_drift_in_words(d: &super::factor::TimeDrift) -> String {
+    let (a, b, how) = if d.r >= 0.0 {
+        (d.from, d.to, "rises")
+    } else {
+        (d.to, d.from, "falls")
+    };
+    format!(
+        "the recorded inflation pressure {how} {:.1} → {:.1} kPa with the run alone (correlation {:.2} of its segment means with time), so a dependence on pressure cannot be told from any other slow drift (temperature, wear): a pressure effect may be present though none is named.",
+        a / 1e3,
+        b / 1e3,
+        d.r
+    )
 }
 
 /// " PPY3 = -3 (its lower bound) is at a bound of its range: …", or "".
@@ -293,20 +323,44 @@ mod tests {
     /// baseline misfits, or one whose size is unknown.
     #[test]
     fn a_small_structure_is_nothing_missing_and_a_large_one_is_not() {
-        let small = explain(&lag(0.0027), None, None, 0.05, false);
+        let small = explain(&lag(0.0027), None, None, 0.05, false, None);
         assert!(small.starts_with("Nothing is missing"), "{small}");
         assert!(small.contains("[0.27 % of its squares]"), "{small}");
-        let large = explain(&lag(0.05), None, None, 0.05, false);
+        let large = explain(&lag(0.05), None, None, 0.05, false, None);
         assert!(
             large.starts_with("The Fy residual follows the force rate"),
             "{large}"
         );
         assert!(large.contains("outside the candidate physics"), "{large}");
         assert!(large.contains("[5.0 % of its squares]"), "{large}");
-        let misfit = explain(&lag(0.0027), None, None, 0.05, true);
+        let misfit = explain(&lag(0.0027), None, None, 0.05, true, None);
         assert!(!misfit.contains("Nothing is missing"), "{misfit}");
-        let unknown = explain(&lag(f64::NAN), None, None, 0.05, false);
+        let unknown = explain(&lag(f64::NAN), None, None, 0.05, false, None);
         assert!(!unknown.contains("Nothing is missing"), "{unknown}");
         assert!(!unknown.contains("% of its squares"), "{unknown}");
+    }
+
+    /// A pressure that drifts with time alone: nothing named is said only
+    /// of what the recording can tell apart, with the drift in kPa.
+    #[test]
+    fn a_pressure_drifting_with_time_qualifies_nothing_missing() {
+        let d = crate::diagnose::factor::TimeDrift {
+            from: 243.1e3,
+            to: 248.9e3,
+            r: 0.98,
+        };
+        let w = time_drift_in_words(&d);
+        let small = explain(&lag(0.0027), None, None, 0.05, false, Some(&w));
+        assert!(
+            small.starts_with("Nothing is missing that this recording can tell apart:"),
+            "{small}"
+        );
+        assert!(small.contains("rises 243.1 → 248.9 kPa"), "{small}");
+        assert!(
+            small.contains("may be present though none is named"),
+            "{small}"
+        );
+        let falling = time_drift_in_words(&crate::diagnose::factor::TimeDrift { r: -0.95, ..d });
+        assert!(falling.contains("falls 248.9 → 243.1 kPa"), "{falling}");
     }
 }

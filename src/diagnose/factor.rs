@@ -7,6 +7,11 @@
 //! pressure whose reading wanders by its noise is not, nor are two binned
 //! "levels" of one belt speed.
 //!
+//! A condition that varies may still vary *with time in the run* alone (a
+//! pressure that rises as the tyre warms, never let down): then a dependence
+//! on it cannot be told from any other slow drift, and a verdict `none` must
+//! say so ([`drift_with_time`]).
+//!
 //! Must never: call a condition varying when its span is within
 //! [`MIN_SPAN_NOISE`] times its noise, or read a sample outside the
 //! segments (or the mask) it is given.
@@ -81,6 +86,16 @@ fn detrended_sd(s: &[Sample], get: fn(&Sample) -> f64) -> Option<f64> {
 /// The 2nd–98th percentile span of `get` over the samples of `segments`
 /// (robust against single spikes; NaN without finite values).
 pub fn span(samples: &[Sample], segments: &[&Segment], get: fn(&Sample) -> f64) -> f64 {
+    percentiles(samples, segments, get).map_or(f64::NAN, |(lo, hi)| hi - lo)
+}
+
+/// The 2nd and 98th percentiles of `get` over the samples of `segments`
+/// (`None` without finite values).
+fn percentiles(
+    samples: &[Sample],
+    segments: &[&Segment],
+    get: fn(&Sample) -> f64,
+) -> Option<(f64, f64)> {
     let mut v: Vec<f64> = segments
         .iter()
         .flat_map(|g| of(samples, g).iter())
@@ -88,11 +103,11 @@ pub fn span(samples: &[Sample], segments: &[&Segment], get: fn(&Sample) -> f64) 
         .filter(|x| x.is_finite())
         .collect();
     if v.is_empty() {
-        return f64::NAN;
+        return None;
     }
     v.sort_by(f64::total_cmp);
     let at = |q: f64| v[((q * (v.len() - 1) as f64).round() as usize).min(v.len() - 1)];
-    at(0.98) - at(0.02)
+    Some((at(0.02), at(0.98)))
 }
 
 /// Whether `get` varies over `segments` by more than [`MIN_SPAN_NOISE`]
@@ -116,6 +131,69 @@ pub fn segment_mean(samples: &[Sample], g: &Segment, get: fn(&Sample) -> f64) ->
     } else {
         sum / n as f64
     }
+}
+
+/// Correlation of a condition's segment means with the segments' mid-times
+/// at or above which the condition is taken to vary with time alone: time
+/// then explains ≥ 81 % of its variance between segments, leaving under a
+/// fifth to tell a dependence on the condition from a drift in time. A
+/// pressure let down once in the run (dev-set r04, r09) stays well below;
+/// one that only rises with the tyre's warming (r20) is near 1.
+pub const TIME_CONFOUNDED_R: f64 = 0.9;
+
+/// A condition that varies beyond its noise, and with time in the run alone.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TimeDrift {
+    /// The 2nd and 98th percentiles of the condition over the segments' samples.
+    pub from: f64,
+    pub to: f64,
+    /// Correlation of the segment means with the segments' mid-times.
+    pub r: f64,
+}
+
+/// `Some` when `get` varies over `segments` beyond its noise
+/// ([`varies_beyond_noise`]) and its segment means follow the segments'
+/// mid-times with |correlation| ≥ [`TIME_CONFOUNDED_R`]; `None` otherwise
+/// (also with fewer than three segments of finite values).
+pub fn drift_with_time(
+    samples: &[Sample],
+    segments: &[&Segment],
+    get: fn(&Sample) -> f64,
+) -> Option<TimeDrift> {
+    if !varies_beyond_noise(span(samples, segments, get), noise(samples, segments, get)) {
+        return None;
+    }
+    let pts: Vec<(f64, f64)> = segments
+        .iter()
+        .map(|g| {
+            let s = of(samples, g);
+            let t = s
+                .first()
+                .zip(s.last())
+                .map_or(f64::NAN, |(a, b)| 0.5 * (a.time + b.time));
+            (t, segment_mean(samples, g, get))
+        })
+        .filter(|(t, v)| t.is_finite() && v.is_finite())
+        .collect();
+    if pts.len() < 3 {
+        return None;
+    }
+    let n = pts.len() as f64;
+    let (mt, mv) = pts
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (t, v)| (a + t / n, b + v / n));
+    let (mut stv, mut stt, mut svv) = (0.0, 0.0, 0.0);
+    for (t, v) in &pts {
+        stv += (t - mt) * (v - mv);
+        stt += (t - mt) * (t - mt);
+        svv += (v - mv) * (v - mv);
+    }
+    let r = stv / (stt * svv).sqrt();
+    if !(r.abs() >= TIME_CONFOUNDED_R) {
+        return None;
+    }
+    let (from, to) = percentiles(samples, segments, get)?;
+    Some(TimeDrift { from, to, r })
 }
 
 #[cfg(test)]
@@ -163,5 +241,41 @@ mod tests {
         // The line in time removes the drift: still the noise.
         assert!((sigma - 100.0).abs() < 2.0, "{sigma}");
         assert!(varies_beyond_noise(span(&drifting, &refs, get), sigma));
+    }
+
+    /// A pressure that only rises through the run varies with time alone;
+    /// one let down once (a saw-tooth), or one held at its set point, not.
+    #[test]
+    fn a_pressure_rising_through_the_run_drifts_with_time() {
+        let n = 4000;
+        let mk = |p: &dyn Fn(f64) -> f64| -> Vec<Sample> {
+            (0..n)
+                .map(|i| Sample {
+                    time: i as f64 * 0.01,
+                    p: p(i as f64 / n as f64) + if i % 2 == 0 { 100.0 } else { -100.0 },
+                    ..Default::default()
+                })
+                .collect()
+        };
+        let segs: Vec<Segment> = (0..20).map(|k| seg(200 * k, 200 * (k + 1))).collect();
+        let refs: Vec<&Segment> = segs.iter().collect();
+        let get: fn(&Sample) -> f64 = |s| s.p;
+        // 243 → 249 kPa, rising as a warming tyre's does (fast, then levelling).
+        let rising = mk(&|x| 243e3 + 6e3 * (1.0 - (-2.5 * x).exp()) / (1.0 - (-2.5f64).exp()));
+        let d = drift_with_time(&rising, &refs, get).expect("drifts with time");
+        assert!(d.r > 0.9, "{d:?}");
+        assert!(
+            (d.from - 243e3).abs() < 400.0 && (d.to - 249e3).abs() < 400.0,
+            "{d:?}"
+        );
+        // Let down once, at 60 % of the run, to its start, then rising again.
+        let saw = mk(&|x| 69e3 + 3.6e3 * if x < 0.6 { x / 0.6 } else { (x - 0.6) / 0.6 });
+        assert!(varies_beyond_noise(
+            span(&saw, &refs, get),
+            noise(&saw, &refs, get)
+        ));
+        assert_eq!(drift_with_time(&saw, &refs, get), None);
+        // Held at its set point: no drift at all.
+        assert_eq!(drift_with_time(&mk(&|_| 2.6e5), &refs, get), None);
     }
 }

@@ -440,12 +440,22 @@ pub fn diagnose_with(
     let in_sample = quality(rec, &base.sim, &extended_sim, &fit_r, &fit_r)?;
     let out_of_sample = quality(rec, &base.sim, &extended_sim, &fit_r, &test_r)?;
     let misfit = misfit_note(&base_fit);
+    // What the recording cannot tell apart when nothing is named: a recorded
+    // pressure that moves with time in the run alone.
+    let unseparable = if verdict_i.is_none() && !slip_verdict {
+        let segs: Vec<&crate::data::Segment> = rec.segments.iter().collect();
+        super::factor::drift_with_time(&rec.samples, &segs, |s| s.p)
+            .map(|d| super::explain::time_drift_in_words(&d))
+    } else {
+        None
+    };
     let mut explanation = explain(
         &findings,
         verdict_i.map(|i| &ev[i].0),
         best_other,
         alpha,
         misfit.is_some() || slip_verdict,
+        unseparable.as_deref(),
     );
     // A qualifier another candidate overshadows is not named: say which, and why.
     if let Some(w) = overshadowed_summary(&ev) {

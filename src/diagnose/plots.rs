@@ -31,7 +31,6 @@
 //!   extended file's Re(Fz) in mm; beside it the free-rolling SR read as a
 //!   force, K_x·(SR − mean SR)/Fz in % of Fz: the `rolling_radius` evidence.
 //!
-//!
 //! The list comes back ordered for the reader (issue #15: plots first, the
 //! evidence for the verdict against the verdict's own variable first of
 //! all): the verdict's evidence plots (`evidence_stems`), the channel the

@@ -52,6 +52,38 @@ pub fn noise(samples: &[Sample], segments: &[&Segment], get: fn(&Sample) -> f64)
     sd[sd.len() / 2]
 }
 
+/// Means of (t, v) pairs and their centred sums of squares and products.
+struct Moments {
+    mt: f64,
+    mv: f64,
+    /// Σ(t − t̄)².
+    stt: f64,
+    /// Σ(t − t̄)(v − v̄).
+    stv: f64,
+    /// Σ(v − v̄)².
+    svv: f64,
+}
+
+fn moments(pts: &[(f64, f64)]) -> Moments {
+    let n = pts.len() as f64;
+    let (mt, mv) = pts
+        .iter()
+        .fold((0.0, 0.0), |(a, b), (t, v)| (a + t / n, b + v / n));
+    let (mut stt, mut stv, mut svv) = (0.0, 0.0, 0.0);
+    for (t, v) in pts {
+        stv += (t - mt) * (v - mv);
+        stt += (t - mt) * (t - mt);
+        svv += (v - mv) * (v - mv);
+    }
+    Moments {
+        mt,
+        mv,
+        stt,
+        stv,
+        svv,
+    }
+}
+
 /// Standard deviation of `get` about its least-squares line in time (None
 /// with fewer than [`MIN_SEGMENT_SAMPLES`] finite values).
 fn detrended_sd(s: &[Sample], get: fn(&Sample) -> f64) -> Option<f64> {
@@ -64,14 +96,9 @@ fn detrended_sd(s: &[Sample], get: fn(&Sample) -> f64) -> Option<f64> {
         return None;
     }
     let n = pts.len() as f64;
-    let (mt, mv) = pts
-        .iter()
-        .fold((0.0, 0.0), |(a, b), (t, v)| (a + t / n, b + v / n));
-    let (mut stv, mut stt) = (0.0, 0.0);
-    for (t, v) in &pts {
-        stv += (t - mt) * (v - mv);
-        stt += (t - mt) * (t - mt);
-    }
+    let Moments {
+        mt, mv, stt, stv, ..
+    } = moments(&pts);
     let k = if stt > 0.0 { stv / stt } else { 0.0 };
     let ss: f64 = pts
         .iter()
@@ -178,16 +205,7 @@ pub fn drift_with_time(
     if pts.len() < 3 {
         return None;
     }
-    let n = pts.len() as f64;
-    let (mt, mv) = pts
-        .iter()
-        .fold((0.0, 0.0), |(a, b), (t, v)| (a + t / n, b + v / n));
-    let (mut stv, mut stt, mut svv) = (0.0, 0.0, 0.0);
-    for (t, v) in &pts {
-        stv += (t - mt) * (v - mv);
-        stt += (t - mt) * (t - mt);
-        svv += (v - mv) * (v - mv);
-    }
+    let Moments { stt, stv, svv, .. } = moments(&pts);
     let r = stv / (stt * svv).sqrt();
     if !(r.abs() >= TIME_CONFOUNDED_R) {
         return None;

@@ -6,6 +6,7 @@
 //! Must never: let the held-out half inform anything it scores (offsets
 //! come from the fit half only).
 
+use crate::data::structure::SegmentOptions;
 use crate::data::Recording;
 use crate::error::Result;
 use crate::fit::metrics::{self, nrmse, sigma};
@@ -55,6 +56,35 @@ pub(crate) fn ranges(mask: &[bool]) -> Vec<Range<usize>> {
         }
     }
     out
+}
+
+/// The belt speeds of the programme, ascending: each the sample-weighted
+/// mean (m/s) of the segments within the segmenter's speed tolerance
+/// (max(0.8 m/s, 5 %), [`SegmentOptions::default`]) of the slowest of its
+/// level, with their indices.
+fn speed_levels(rec: &Recording) -> Vec<(f64, Vec<usize>)> {
+    let t = SegmentOptions::default();
+    let mut order: Vec<usize> = (0..rec.segments.len())
+        .filter(|&k| rec.segments[k].vx.is_finite())
+        .collect();
+    order.sort_by(|&a, &b| rec.segments[a].vx.total_cmp(&rec.segments[b].vx));
+    let mut levels: Vec<(f64, Vec<usize>)> = Vec::new();
+    for k in order {
+        let v = rec.segments[k].vx;
+        match levels.last_mut() {
+            Some((anchor, m)) if v - *anchor <= t.v_abs.max(t.v_rel * v.abs()) => m.push(k),
+            _ => levels.push((v, vec![k])),
+        }
+    }
+    levels
+        .into_iter()
+        .map(|(_, m)| {
+            let w = |k: &usize| rec.segments[*k].len().max(1) as f64;
+            let total: f64 = m.iter().map(w).sum();
+            let v = m.iter().map(|k| w(k) * rec.segments[*k].vx).sum::<f64>() / total;
+            (v, m)
+        })
+        .collect()
 }
 
 /// One row of the quality table.
@@ -133,22 +163,11 @@ pub fn quality(
             });
         }
         // Per speed, when the programme has more than one.
-        let mut speeds: Vec<f64> = rec
-            .segments
-            .iter()
-            .map(|g| (g.vx * 10.0).round() / 10.0)
-            .filter(|v| v.is_finite())
-            .collect();
-        speeds.sort_by(f64::total_cmp);
-        speeds.dedup();
+        let speeds = speed_levels(rec);
         if speeds.len() > 1 {
-            for v in speeds {
+            for (v, members) in speeds {
                 let (mut yy, mut pb, mut pa) = (Vec::new(), Vec::new(), Vec::new());
-                for g in rec
-                    .segments
-                    .iter()
-                    .filter(|g| (g.vx * 10.0).round() / 10.0 == v)
-                {
+                for g in members.iter().map(|&k| &rec.segments[k]) {
                     for r in ranges {
                         for i in g.start.max(r.start)..g.end.min(r.end).min(y.len()) {
                             yy.push(y[i]);
@@ -157,7 +176,7 @@ pub fn quality(
                         }
                     }
                 }
-                if !yy.is_empty() {
+                if yy.iter().any(|x| x.is_finite()) {
                     rows.push(QualityRow {
                         channel: ch,
                         condition: format!("Vx {:.0} km/h", 3.6 * v),
@@ -184,4 +203,41 @@ pub struct QualityReport {
     pub split: &'static str,
     pub in_sample: Vec<QualityRow>,
     pub out_of_sample: Vec<QualityRow>,
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::data::{Recording, Segment, SegmentKind};
+
+    /// Speed-controlled repeats (8.86, 8.90, 8.93 m/s) are one level; 32,
+    /// 40 and 48 km/h three; each level's speed is its sample-weighted mean.
+    #[test]
+    fn speed_levels_pool_the_repeats_of_a_set_point() {
+        let seg = |start: usize, len: usize, vx: f64| Segment {
+            start,
+            end: start + len,
+            kind: SegmentKind::PureLongitudinal,
+            fz: 1000.0,
+            gamma: 0.0,
+            p: 83e3,
+            vx,
+            alpha: 0.0,
+        };
+        let rec = Recording {
+            segments: vec![
+                seg(0, 10, 11.10),
+                seg(10, 10, 8.90),
+                seg(20, 30, 13.33),
+                seg(50, 10, 8.86),
+                seg(60, 10, 8.93),
+                seg(70, 10, f64::NAN),
+            ],
+            ..Default::default()
+        };
+        let l = super::speed_levels(&rec);
+        let members: Vec<&[usize]> = l.iter().map(|(_, m)| m.as_slice()).collect();
+        assert_eq!(members, [&[3, 1, 4][..], &[0], &[2]]);
+        assert!((l[0].0 - (8.86 + 8.90 + 8.93) / 3.0).abs() < 1e-12);
+        assert_eq!(l[2].0, 13.33);
+    }
 }

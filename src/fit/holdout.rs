@@ -15,7 +15,7 @@
 //!
 //! Must never: put one sample in both halves, or choose at random.
 
-use super::metrics::{conditions, Condition};
+use super::metrics::condition_groups;
 use crate::data::Recording;
 use std::ops::Range;
 
@@ -119,19 +119,19 @@ impl Holdout {
                 h
             }
             Holdout::ByCondition { every } => {
-                let conds = conditions(rec);
-                let mut out: Vec<bool> = (0..conds.len()).map(|i| (i + 1) % every == 0).collect();
-                if !out.iter().any(|&x| x) && conds.len() >= 2 {
-                    let l = conds.len() - 1;
+                let groups = condition_groups(rec);
+                let mut out: Vec<bool> = (0..groups.len()).map(|i| (i + 1) % every == 0).collect();
+                if !out.iter().any(|&x| x) && groups.len() >= 2 {
+                    let l = groups.len() - 1;
                     out[l] = true;
                 }
-                let idx = |s: &crate::data::Segment| {
-                    let c = Condition::of(s);
-                    conds.iter().position(|o| o.same(&c))
-                };
-                segs.iter()
-                    .map(|s| idx(s).is_some_and(|i| out[i]))
-                    .collect()
+                let mut held = vec![false; segs.len()];
+                for (g, &h) in groups.iter().zip(&out) {
+                    for &k in &g.segments {
+                        held[k] = h;
+                    }
+                }
+                held
             }
         };
         // Mark samples, then turn the marks into ranges.

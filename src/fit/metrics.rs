@@ -13,6 +13,7 @@
 // Index loops over parallel per-sample arrays read clearer than zips.
 #![allow(clippy::needless_range_loop, clippy::single_range_in_vec_init)]
 
+use crate::data::structure::SegmentOptions;
 use crate::data::{Recording, Sample};
 use std::ops::Range;
 
@@ -84,7 +85,8 @@ pub fn channel_value(s: &Sample, channel: &str) -> Option<f64> {
     })
 }
 
-/// A test condition: the set points of a segment.
+/// A test condition: the set points of a segment, or the mean set points of
+/// the segments that share one.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Condition {
     /// Normal load (N).
@@ -104,31 +106,111 @@ impl Condition {
             p: seg.p,
         }
     }
-    /// Equal set points (relative tolerance 1e-9: they are binned values).
+    /// One test condition: every set point within the tolerance the
+    /// segmenter bins its levels with ([`SegmentOptions::default`]: load
+    /// max(60 N, 8 %), inclination 0.6°, pressure 5 kPa). A segment's set
+    /// points are the medians of its samples, so the repeats of one
+    /// load-controlled set point differ by a few newtons (221.4, 221.7,
+    /// 222.0 N) and must not count as three conditions. A set point missing
+    /// in both (NaN) is equal.
     pub fn same(&self, o: &Condition) -> bool {
-        let eq = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1e-9);
-        eq(self.fz, o.fz) && eq(self.gamma, o.gamma) && eq(self.p, o.p)
+        let t = SegmentOptions::default();
+        let near = |a: f64, b: f64, tol: f64| (a - b).abs() <= tol || (a.is_nan() && b.is_nan());
+        let fz_tol = t.fz_abs.max(t.fz_rel * self.fz.abs().max(o.fz.abs()));
+        near(self.fz, o.fz, fz_tol)
+            && near(self.gamma, o.gamma, t.gamma_tol)
+            && near(self.p, o.p, t.p_tol)
     }
-    fn key(&self) -> (f64, f64, f64) {
-        (self.fz, self.gamma, self.p)
+    fn order(&self, o: &Condition) -> std::cmp::Ordering {
+        self.fz
+            .total_cmp(&o.fz)
+            .then(self.gamma.total_cmp(&o.gamma))
+            .then(self.p.total_cmp(&o.p))
     }
 }
 
-/// Distinct conditions of a recording's segments, sorted by (load, inclination, pressure).
-pub fn conditions(rec: &Recording) -> Vec<Condition> {
-    let mut out: Vec<Condition> = Vec::new();
-    for s in &rec.segments {
-        let c = Condition::of(s);
-        if !out.iter().any(|o| o.same(&c)) {
-            out.push(c);
+/// One test condition and the segments (indices into `rec.segments`) run at it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ConditionGroup {
+    /// The members' set points, weighted by their sample counts.
+    pub condition: Condition,
+    /// Indices of the member segments, in time order.
+    pub segments: Vec<usize>,
+}
+
+/// The test conditions of a recording, sorted by (load level, inclination,
+/// pressure). Segments join a condition by [`Condition::same`] with its
+/// first member in that order (its lightest), so a slow drift cannot chain
+/// distinct set points into one.
+pub fn condition_groups(rec: &Recording) -> Vec<ConditionGroup> {
+    let segs = &rec.segments;
+    let mut order: Vec<usize> = (0..segs.len()).collect();
+    order.sort_by(|&a, &b| Condition::of(&segs[a]).order(&Condition::of(&segs[b])));
+    let mut groups: Vec<(Condition, Vec<usize>)> = Vec::new();
+    for i in order {
+        let c = Condition::of(&segs[i]);
+        match groups.iter_mut().find(|g| g.0.same(&c)) {
+            Some(g) => g.1.push(i),
+            None => groups.push((c, vec![i])),
         }
     }
-    out.sort_by(|a, b| {
-        a.key()
-            .partial_cmp(&b.key())
-            .unwrap_or(std::cmp::Ordering::Equal)
+    let mut out: Vec<ConditionGroup> = groups
+        .into_iter()
+        .map(|(_, mut members)| {
+            members.sort_unstable();
+            let mean = |f: fn(&crate::data::Segment) -> f64| {
+                let (mut s, mut w) = (0.0, 0.0);
+                for &i in &members {
+                    let (x, n) = (f(&segs[i]), segs[i].len().max(1) as f64);
+                    if x.is_finite() {
+                        s += n * x;
+                        w += n;
+                    }
+                }
+                if w > 0.0 {
+                    s / w
+                } else {
+                    f64::NAN
+                }
+            };
+            ConditionGroup {
+                condition: Condition {
+                    fz: mean(|g| g.fz),
+                    gamma: mean(|g| g.gamma),
+                    p: mean(|g| g.p),
+                },
+                segments: members,
+            }
+        })
+        .collect();
+    // Order by load level (the loads of one level differ by a few newtons
+    // between inclinations), then inclination, then pressure.
+    out.sort_by(|a, b| a.condition.order(&b.condition));
+    let t = SegmentOptions::default();
+    let mut level = Vec::with_capacity(out.len());
+    let mut anchor = f64::NAN;
+    for g in &out {
+        let fz = g.condition.fz;
+        if !((fz - anchor).abs() <= t.fz_abs.max(t.fz_rel * fz.abs().max(anchor.abs()))) {
+            anchor = fz;
+        }
+        level.push(anchor);
+    }
+    let mut keyed: Vec<(f64, ConditionGroup)> = level.into_iter().zip(out).collect();
+    keyed.sort_by(|(la, a), (lb, b)| {
+        la.total_cmp(lb)
+            .then(a.condition.gamma.total_cmp(&b.condition.gamma))
+            .then(a.condition.p.total_cmp(&b.condition.p))
     });
-    out
+    keyed.into_iter().map(|(_, g)| g).collect()
+}
+
+/// Distinct conditions of a recording ([`condition_groups`] without the members).
+pub fn conditions(rec: &Recording) -> Vec<Condition> {
+    condition_groups(rec)
+        .into_iter()
+        .map(|g| g.condition)
+        .collect()
 }
 
 /// Metrics of one channel over one set of samples.
@@ -156,7 +238,8 @@ fn metric(channel: &str, condition: Option<Condition>, sim: &[f64], test: &[f64]
 }
 
 /// Metrics of `channel` with simulated values `sim` (one per sample of `rec`):
-/// first the row over all selected samples, then one row per condition.
+/// first the row over all selected samples, then one row per condition
+/// ([`condition_groups`]) with a measured value in the selection.
 /// `subset` restricts to these sample ranges (e.g. a hold-out split);
 /// `None` = all samples.
 pub fn evaluate(
@@ -190,12 +273,9 @@ pub fn evaluate(
         }
     }
     let mut out = vec![metric(channel, None, &s_all, &t_all)];
-    for c in conditions(rec) {
+    for g in condition_groups(rec) {
         let (mut s, mut t) = (Vec::new(), Vec::new());
-        for seg in &rec.segments {
-            if !Condition::of(seg).same(&c) {
-                continue;
-            }
+        for seg in g.segments.iter().map(|&k| &rec.segments[k]) {
             for i in seg.start.min(n)..seg.end.min(n) {
                 if selected(i) {
                     s.push(sim[i]);
@@ -203,8 +283,10 @@ pub fn evaluate(
                 }
             }
         }
-        if !t.is_empty() {
-            out.push(metric(channel, Some(c), &s, &t));
+        // A condition without a measured value of the channel in the
+        // selection (e.g. Fx at a cornering-only condition) has no row.
+        if t.iter().any(|y| y.is_finite()) {
+            out.push(metric(channel, Some(g.condition), &s, &t));
         }
     }
     Ok(out)
@@ -232,5 +314,88 @@ mod tests {
         // flat or empty channel → NaN, not a division by zero
         assert!(nrmse(&[1.0], &[2.0]).is_nan());
         assert!(sigma(&[1.0], &[0.0]).is_nan());
+    }
+
+    fn seg(start: usize, end: usize, fz: f64, gamma_deg: f64, p_kpa: f64) -> crate::data::Segment {
+        crate::data::Segment {
+            start,
+            end,
+            kind: crate::data::SegmentKind::PureLateral,
+            fz,
+            gamma: gamma_deg.to_radians(),
+            p: p_kpa * 1e3,
+            vx: 11.1,
+            alpha: 0.0,
+        }
+    }
+
+    /// The repeats of one load-controlled set point (medians 221.4 / 222.0 /
+    /// 221.7 N, as an FSAE programme's 50 lb level records) are one
+    /// condition; the next inclination (1°, beyond the segmenter's 0.6°),
+    /// the next pressure (69 vs 83 kPa) and the next load (331 N) are not;
+    /// a pressure drifting 243 → 246.5 kPa stays one.
+    #[test]
+    fn repeats_of_a_set_point_are_one_condition() {
+        let mut rec = Recording {
+            samples: vec![Sample::default(); 100],
+            ..Default::default()
+        };
+        for (k, (fz, g, p)) in [
+            (221.4, 0.0, 83.0),
+            (331.0, 0.0, 83.0),
+            (222.0, 0.0, 83.0),
+            (222.2, 1.0, 83.0),
+            (221.7, 0.0, 83.0),
+            (221.9, 0.0, 69.0),
+            (1550.0, 0.0, 243.0),
+            (1561.0, 0.0, 246.5),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            rec.segments.push(seg(10 * k, 10 * k + 10, fz, g, p));
+        }
+        let g = condition_groups(&rec);
+        let members: Vec<&[usize]> = g.iter().map(|g| g.segments.as_slice()).collect();
+        // Load level first, then inclination, then pressure.
+        assert_eq!(members, [&[5][..], &[0, 2, 4], &[3], &[1], &[6, 7]]);
+        let c = g[1].condition;
+        assert!((c.fz - (221.4 + 222.0 + 221.7) / 3.0).abs() < 1e-9);
+        assert_eq!(g[2].condition.gamma, 1f64.to_radians());
+        assert!((g[4].condition.p - 244_750.0).abs() < 1e-6);
+        assert_eq!(conditions(&rec).len(), 5);
+        // The metrics have one row per condition with data, the repeats pooled.
+        let mut fy = vec![f64::NAN; 100];
+        for (i, s) in rec.samples.iter_mut().enumerate() {
+            s.fy = if i < 60 {
+                1.0 + (i % 3) as f64
+            } else {
+                f64::NAN
+            };
+            fy[i] = s.fy;
+        }
+        let m = evaluate(&rec, "Fy", &fy, None).unwrap();
+        assert_eq!(m.len(), 1 + 4, "the 1550 N condition has no Fy: no row");
+        assert_eq!(m[2].n, 30);
+        // No chaining: 100, 106, 112 … N each within 8 % of the last are not one level.
+        let mut drift = Recording {
+            samples: vec![Sample::default(); 100],
+            ..Default::default()
+        };
+        for k in 0..10 {
+            let fz = 1000.0 * 1.06f64.powi(k);
+            drift
+                .segments
+                .push(seg(10 * k as usize, 10 * k as usize + 10, fz, 0.0, 83.0));
+        }
+        assert!(condition_groups(&drift).len() >= 5);
+        // A recording without a pressure channel (NaN set points) is one condition, not ten.
+        for s in &mut drift.segments {
+            s.fz = 1000.0;
+            s.p = f64::NAN;
+        }
+        let g = condition_groups(&drift);
+        assert_eq!(g.len(), 1);
+        assert!(g[0].condition.p.is_nan());
     }
 }

@@ -4,7 +4,7 @@
 //! Must never: change the tyre or the recording (it only draws them).
 
 use crate::data::{Recording, SegmentKind};
-use crate::fit::metrics::Condition;
+use crate::fit::metrics::{condition_groups, Condition};
 use crate::fit::mf_stages::{Channel, StageKind, FIT_MODE};
 use crate::mf::{MfInput, Tyre};
 use crate::{Error, Result};
@@ -29,11 +29,13 @@ pub fn plot_fit(
             if !rec.has(ch.name()) {
                 continue;
             }
-            for cond in crate::fit::metrics::conditions(rec) {
-                let segs: Vec<_> = rec
+            for group in condition_groups(rec) {
+                let cond = group.condition;
+                let segs: Vec<_> = group
                     .segments
                     .iter()
-                    .filter(|s| s.kind == seg_kind && Condition::of(s).same(&cond))
+                    .map(|&k| &rec.segments[k])
+                    .filter(|s| s.kind == seg_kind)
                     .collect();
                 if segs.is_empty() {
                     continue;

@@ -131,15 +131,22 @@ fn missing_channels_are_reported() {
         "time,Fz,alpha,Fy\n0,1000,0.01,-100\n0.1,1000,0.02,-200\n",
     )
     .unwrap();
-    for m in [
-        "Vx", "omega", "kappa", "gamma", "P", "Fx", "Mx", "My", "Mz", "phit",
-    ] {
+    for m in ["Vx", "omega", "gamma", "P", "Fx", "Mx", "My", "Mz", "phit"] {
         assert!(
             l.report.missing.iter().any(|x| x == m),
             "{m} not reported missing"
         );
     }
-    assert!(l.report.kappa.starts_with("missing"));
+    // No wheel speed or slip channel, no Fx: a cornering test rolls freely,
+    // and κ = 0 is taken and said, not left NaN (which no fit stage can use).
+    assert!(
+        l.report
+            .kappa
+            .starts_with("κ = 0: no wheel speed or slip channel"),
+        "{}",
+        l.report.kappa
+    );
+    assert!(l.recording.samples.iter().all(|s| s.kappa == 0.0));
     // No normal load: an error, not a guess.
     expect_recording_error(load_str("nofz.csv", "time,Fy\n0,1\n"), "FZ");
 }
@@ -249,4 +256,66 @@ fn million_rows_load_time() {
         t0.elapsed().as_secs_f64()
     );
     assert!(l.recording.segments.len() == r.plan.len());
+}
+
+/// Without a wheel speed, κ comes from what else the file holds: the rig's
+/// slip ratio SR where it reads as one (a TTC export without N; in a CSV,
+/// SR is the κ column itself), κ = 0 on a run that rolls freely, and
+/// nothing (reported missing, with why) on a drive/brake run without either.
+#[test]
+fn slip_without_a_wheel_speed() {
+    // TTC layout (SAE axes, kph, deg): a brake sweep to SR = ∓0.1, Fx ±800 N at 1 kN.
+    let ttc = |sr_scale: f64, with_sr: bool| {
+        let mut t = String::from(if with_sr {
+            "ET\tV\tSA\tIA\tP\tFX\tFY\tFZ\tSR\ns\tkph\tdeg\tdeg\tkPa\tN\tN\tN\t-\n"
+        } else {
+            "ET\tV\tSA\tIA\tP\tFX\tFY\tFZ\ns\tkph\tdeg\tdeg\tkPa\tN\tN\tN\n"
+        });
+        for i in 0..400 {
+            let x = 2.0 * (i as f64 / 400.0) - 1.0;
+            t.push_str(&format!(
+                "{:.2}\t40\t0.02\t0\t83\t{:.1}\t-10\t-1000",
+                0.01 * i as f64,
+                -800.0 * x
+            ));
+            if with_sr {
+                t.push_str(&format!("\t{:.5}", -0.1 * x * sr_scale));
+            }
+            t.push('\n');
+        }
+        t
+    };
+    let l = load_str("sr.dat", &ttc(1.0, true)).unwrap();
+    assert!(
+        l.report.kappa.starts_with("κ = the recorded slip ratio SR"),
+        "{}",
+        l.report.kappa
+    );
+    for (i, s) in l.recording.samples.iter().enumerate() {
+        let x = 2.0 * (i as f64 / 400.0) - 1.0;
+        assert!((s.kappa + 0.1 * x).abs() < 1e-9, "κ {} at row {i}", s.kappa);
+    }
+    // SR in percent is not a ratio: not taken as κ, and the run brakes, so no κ = 0 either.
+    let l = load_str("srpct.dat", &ttc(100.0, true)).unwrap();
+    assert!(
+        l.report.kappa.starts_with("missing") && l.report.kappa.contains("does not roll freely"),
+        "{}",
+        l.report.kappa
+    );
+    // No slip channel on a drive/brake run: the same.
+    let l = load_str("nosr.dat", &ttc(1.0, false)).unwrap();
+    assert!(l.report.kappa.starts_with("missing"), "{}", l.report.kappa);
+    // A CSV that rolls freely (|Fx| ≪ Fz) without wheel speed or slip: κ = 0.
+    let mut t = String::from("time,Vx,Fz,alpha,Fx,Fy\n");
+    for i in 0..200 {
+        let a = 0.1 * (0.05 * i as f64).sin();
+        t.push_str(&format!(
+            "{},10,1000,{a},-15,{}\n",
+            0.01 * i as f64,
+            -20000.0 * a
+        ));
+    }
+    let l = load_str("free.csv", &t).unwrap();
+    assert!(l.report.kappa.starts_with("κ = 0"), "{}", l.report.kappa);
+    assert!(l.recording.samples.iter().all(|s| s.kappa == 0.0));
 }

@@ -89,3 +89,73 @@ fn tyredata_fy_mz_fit_and_tir_reload() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The same real test with its wheel-speed, effective-radius and slip-ratio
+/// columns removed — the form many shared lateral tests take — loads with
+/// κ = 0 (it rolls freely) and fits pure Fy as well as the full file:
+/// before, κ stayed NaN and no stage had a usable sample. The full file
+/// records SR = 0 throughout, so the two fits see the same slips; 5 % of σ
+/// leaves room for the segmenter's and the geometry's use of the removed
+/// columns, nothing more.
+#[test]
+fn tyredata_without_wheel_speed_fits_as_free_rolling() {
+    let path = common::shared().join("data/measurements/TyreData.csv");
+    let Ok(text) = std::fs::read_to_string(&path) else {
+        eprintln!(
+            "SKIP: {} absent (shared data not available)",
+            path.display()
+        );
+        return;
+    };
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let keep: Vec<usize> = (0..header.len())
+        .filter(|&i| !["W [rad/s]", "Re [m]", "SR [-]"].contains(&header[i].trim()))
+        .collect();
+    assert_eq!(
+        keep.len(),
+        header.len() - 3,
+        "columns not found: {header:?}"
+    );
+    let pick = |l: &str| {
+        let f: Vec<&str> = l.split(',').collect();
+        keep.iter().map(|&i| f[i]).collect::<Vec<_>>().join(",")
+    };
+    let mut cut = pick(&header.join(","));
+    for l in lines {
+        cut.push('\n');
+        cut.push_str(&pick(l));
+    }
+    let dir = std::env::temp_dir().join(format!("tyrekit_fit_mf_td_now_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join("TyreData_no_wheel_speed.csv");
+    std::fs::write(&p, cut).unwrap();
+    let loaded = tyrekit::data::load(&p, &tyrekit::data::LoadOptions::default()).unwrap();
+    assert!(
+        loaded
+            .report
+            .kappa
+            .starts_with("κ = 0: no wheel speed or slip channel"),
+        "{}",
+        loaded.report.kappa
+    );
+    let opts = MfFitOptions {
+        only: vec![StageKind::PureFy],
+        ..Default::default()
+    };
+    let sigma_fy = |rec: Recording| {
+        let res = fit_mf(&[rec], TyreParams::builtin(), &opts, None).unwrap();
+        overall_sigma(&res.report.metrics, "Fy").unwrap()
+    };
+    let without = sigma_fy(loaded.recording);
+    let full = sigma_fy(Recording::from_file(&path).unwrap());
+    println!(
+        "σ_Fy without wheel speed {:.3} %, full file {:.3} %",
+        100.0 * without,
+        100.0 * full
+    );
+    assert!(
+        without < 1.05 * full,
+        "σ_Fy {without} without wheel speed against {full}"
+    );
+}

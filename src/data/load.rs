@@ -727,17 +727,32 @@ pub fn from_raw(raw: RawTable, format: Format, file: &str, opts: &LoadOptions) -
                     channels.push("kappa".into());
                 }
             }
-            // A rejected (broken) wheel speed or κ on a freely rolling run.
+            // No usable wheel speed, but the rig's own slip ratio: κ is it
+            // (the channel the wheel speed would otherwise be checked against).
+            None if !has_kappa && sr.is_some_and(slip::plausible_slip_ratio) => {
+                let sr = sr.unwrap_or_default();
+                for (s, &x) in samples.iter_mut().zip(sr) {
+                    s.kappa = x;
+                }
+                channels.push("kappa".into());
+                report.kappa = "κ = the recorded slip ratio SR (no usable wheel speed to compute or check it; a replay prescribes these slips)".into();
+            }
+            // No usable wheel speed or slip channel on a freely rolling run
+            // (a cornering-only test): free rolling, κ = 0, said so.
             None if !has_kappa
-                && (has(Ch::Omega) || has(Ch::Kappa))
                 && sanity::free_rolling_run(&samples, channels.iter().any(|c| c == "Fx")) =>
             {
                 samples.iter_mut().for_each(|s| s.kappa = 0.0);
                 channels.push("kappa".into());
-                report.kappa = "κ = 0: no usable wheel speed, and the run rolls freely (|Fx| < 10 % Fz on 95 % of the loaded rows)".into();
+                report.kappa = if has(Ch::Omega) || has(Ch::Kappa) {
+                    "κ = 0: no usable wheel speed, and the run rolls freely (|Fx| < 10 % Fz on 95 % of the loaded rows)"
+                } else {
+                    "κ = 0: no wheel speed or slip channel recorded, and the run rolls freely (|Fx| < 10 % Fz on 95 % of the loaded rows)"
+                }
+                .into();
             }
             None => {
-                report.kappa = "missing (no usable wheel speed / radius to compute it)".into();
+                report.kappa = "missing (no usable wheel speed / radius to compute it, no slip-ratio channel SR, and the run does not roll freely: drive/brake rows cannot be used)".into();
             }
         }
     } else if has_kappa {

@@ -257,6 +257,23 @@ pub fn kappa(omega: f64, re: f64, vx: f64) -> f64 {
     omega * re / vx - 1.0
 }
 
+/// Whether a recorded slip-ratio channel reads as a ratio: finite on most
+/// rows and |SR| < 0.5 on 95 % of them (drive/brake sweeps stay within
+/// ±0.3; a channel in percent, or one computed from a dead wheel speed,
+/// does not).
+pub(crate) fn plausible_slip_ratio(sr: &[f64]) -> bool {
+    let mut a: Vec<f64> = sr
+        .iter()
+        .filter(|x| x.is_finite())
+        .map(|x| x.abs())
+        .collect();
+    if a.len() < 2 || a.len() * 2 < sr.len() {
+        return false;
+    }
+    a.sort_by(f64::total_cmp);
+    a[(a.len() * 95 / 100).min(a.len() - 1)] < 0.5
+}
+
 /// Compute κ for all samples; returns how (the Re used), or `None` when Ω
 /// or V is missing or no radius is available.
 ///

@@ -182,3 +182,29 @@ fn no_usable_stage_is_an_error_not_a_written_file() {
         &["cannot be analysed"],
     );
 }
+
+#[test]
+fn a_drive_brake_run_without_any_slip_says_why_no_stage_fits() {
+    // Braking sweeps at 4 kN (|Fx| to 60 % of Fz) with no wheel speed and
+    // no slip channel: κ cannot be known and free rolling cannot be
+    // assumed. The error must name the missing slip, not only count zero
+    // samples in segments that are plainly there.
+    let p = tmp("noslip.csv");
+    let mut t = String::from("time,Vx,Fz,alpha,gamma,Fx,Fy\n");
+    for i in 0..2000 {
+        let x = ((i as f64) * 0.01).sin();
+        t.push_str(&format!(
+            "{},10,4000,0,0,{},{}\n",
+            i as f64 * 0.01,
+            -2400.0 * x,
+            30.0 * x
+        ));
+    }
+    std::fs::write(&p, t).unwrap();
+    let out = tmp("noslip.tir");
+    assert_fails(
+        &["fit", s(&p), "--out", s(&out)],
+        &["no slip ratio κ", "data summary"],
+    );
+    assert!(!out.exists());
+}

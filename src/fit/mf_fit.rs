@@ -507,6 +507,34 @@ fn drive_brake_load_spread(conds: &[crate::mf::Conditions], fz0: f64) -> f64 {
     at(0.95) - at(0.05)
 }
 
+/// Why the samples of `seg` segments could not be used, when they exist but
+/// lack a model input ("" otherwise): the slip or speed the loader could not
+/// derive says more than a count of zero.
+fn unusable_inputs(recs: &[Recording], seg: SegmentKind) -> String {
+    let (mut n, mut kappa, mut vx) = (0usize, 0usize, 0usize);
+    for rec in recs {
+        for g in rec.segments.iter().filter(|g| g.kind == seg) {
+            for s in &rec.samples[g.start.min(rec.samples.len())..g.end.min(rec.samples.len())] {
+                n += 1;
+                kappa += usize::from(!s.kappa.is_finite());
+                vx += usize::from(!s.vx.is_finite());
+            }
+        }
+    }
+    let mut why = Vec::new();
+    if n > 0 && kappa * 2 > n {
+        why.push("no slip ratio κ (no usable wheel speed, no slip channel, and the run does not roll freely: see `tyrekit data summary`)");
+    }
+    if n > 0 && vx * 2 > n {
+        why.push("no speed channel (Vx or the belt speed)");
+    }
+    if why.is_empty() {
+        String::new()
+    } else {
+        format!(": {n} samples there, but {}", why.join("; "))
+    }
+}
+
 /// Run stage `kind` from the values of `tyre` on the fitted rows: its
 /// channels where recorded, its samples (the combined stage: the combined
 /// rows and the pure ones, see below), its parameter table. `multi_start`:
@@ -561,11 +589,12 @@ pub(crate) fn run_stage(
             }
             None => {
                 return Ok(StageRun::Skipped(format!(
-                    "{}: {} samples in {} segments (need {})",
+                    "{}: {} samples in {} segments (need {}){}",
                     kind.name(),
                     data.conds.len(),
                     seg.label(),
-                    opts.min_samples
+                    opts.min_samples,
+                    unusable_inputs(recs, seg)
                 )))
             }
         }

@@ -42,6 +42,7 @@
 use super::report::{channel_present, channel_series, split, Diagnosis};
 use crate::data::Recording;
 use crate::error::{Error, Result};
+use crate::fit::metrics::same_load_level;
 use crate::residual::Channel;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -258,25 +259,18 @@ fn before_after(
 const MAX_PANELS: usize = 6;
 
 /// The load levels (N) of a programme's segment loads, lightest first: a
-/// new level where a load is not [`same_level`] as the last level's first
+/// new level where a load is not [`same_load_level`] as the last level's first
 /// load; each level its first (lightest) load.
 fn load_levels(fz: impl Iterator<Item = f64>) -> Vec<f64> {
     let mut v: Vec<f64> = fz.filter(|x| x.is_finite()).collect();
     v.sort_by(f64::total_cmp);
     let mut levels: Vec<f64> = Vec::new();
     for x in v {
-        if levels.last().is_none_or(|&l| !same_level(l, x)) {
+        if levels.last().is_none_or(|&l| !same_load_level(l, x)) {
             levels.push(x);
         }
     }
     levels
-}
-
-/// Whether two segment loads (N) are one load level: within 10 % of the
-/// larger (set points of a programme differ by ≥ 30 %; load control holds
-/// a level within a few %).
-fn same_level(a: f64, b: f64) -> bool {
-    (a - b).abs() <= 0.1 * a.abs().max(b.abs())
 }
 
 /// Common y range of several point sets (robust: 0.5 % / 99.5 % quantiles,
@@ -533,7 +527,7 @@ fn residual_slip(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
     let path = dir.join(&file);
     let idx = c.inside(MAX_POINTS);
     let loads = load_levels(c.rec.segments.iter().map(|g| g.fz));
-    let level_of = |fz: f64| loads.iter().position(|&l| same_level(l, fz));
+    let level_of = |fz: f64| loads.iter().position(|&l| same_load_level(l, fz));
     let seg_of = segment_index(c.rec);
     let series = |after: bool| -> Vec<Series> {
         loads
@@ -966,7 +960,7 @@ fn overlay(c: &Chan, verdict: &str, dir: &Path) -> Result<Plot> {
     // lightest load first: the curves per load.
     let mut panels: Vec<(f64, bool, std::ops::Range<usize>)> = Vec::new();
     for (out, _, fz, r) in &ranked {
-        if !panels.iter().any(|(l, ..)| same_level(*l, *fz)) {
+        if !panels.iter().any(|(l, ..)| same_load_level(*l, *fz)) {
             panels.push((*fz, *out, r.clone()));
         }
     }

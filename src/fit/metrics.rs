@@ -116,8 +116,7 @@ impl Condition {
     pub fn same(&self, o: &Condition) -> bool {
         let t = SegmentOptions::default();
         let near = |a: f64, b: f64, tol: f64| (a - b).abs() <= tol || (a.is_nan() && b.is_nan());
-        let fz_tol = t.fz_abs.max(t.fz_rel * self.fz.abs().max(o.fz.abs()));
-        near(self.fz, o.fz, fz_tol)
+        (same_load_level(self.fz, o.fz) || (self.fz.is_nan() && o.fz.is_nan()))
             && near(self.gamma, o.gamma, t.gamma_tol)
             && near(self.p, o.p, t.p_tol)
     }
@@ -127,6 +126,15 @@ impl Condition {
             .then(self.gamma.total_cmp(&o.gamma))
             .then(self.p.total_cmp(&o.p))
     }
+}
+
+/// Whether two loads (N) are one load level: within the tolerance the
+/// segmenter bins load set points with, max(60 N, 8 %) of the larger
+/// ([`SegmentOptions::default`]; a programme's set points differ by ≥ 30 %,
+/// load control holds a level within a few %). False when either is NaN.
+pub fn same_load_level(a: f64, b: f64) -> bool {
+    let t = SegmentOptions::default();
+    (a - b).abs() <= t.fz_abs.max(t.fz_rel * a.abs().max(b.abs()))
 }
 
 /// One test condition and the segments (indices into `rec.segments`) run at it.
@@ -186,12 +194,11 @@ pub fn condition_groups(rec: &Recording) -> Vec<ConditionGroup> {
     // Order by load level (the loads of one level differ by a few newtons
     // between inclinations), then inclination, then pressure.
     out.sort_by(|a, b| a.condition.order(&b.condition));
-    let t = SegmentOptions::default();
     let mut level = Vec::with_capacity(out.len());
     let mut anchor = f64::NAN;
     for g in &out {
         let fz = g.condition.fz;
-        if !((fz - anchor).abs() <= t.fz_abs.max(t.fz_rel * fz.abs().max(anchor.abs()))) {
+        if !same_load_level(anchor, fz) {
             anchor = fz;
         }
         level.push(anchor);

@@ -319,3 +319,92 @@ fn slip_without_a_wheel_speed() {
     assert!(l.report.kappa.starts_with("κ = 0"), "{}", l.report.kappa);
     assert!(l.recording.samples.iter().all(|s| s.kappa == 0.0));
 }
+
+/// TTC layout without wheel speed or slip channel: `blocks` of (seconds,
+/// braking) at 1 kN, 100 Hz; cornering blocks sweep SA ±8° with Fx at
+/// `fx0` plus ±25 N of deterministic noise, braking blocks sweep Fx from 0
+/// to −1200 N and back at SA 0.
+fn ttc_without_slip(blocks: &[(f64, bool)], fx0: f64) -> String {
+    let mut t = String::from("ET\tV\tSA\tIA\tP\tFX\tFY\tFZ\ns\tkph\tdeg\tdeg\tkPa\tN\tN\tN\n");
+    let mut i = 0usize;
+    for &(secs, braking) in blocks {
+        let n = (secs * 100.0) as usize;
+        for k in 0..n {
+            let u = k as f64 / n as f64;
+            let noise = 25.0 * ((i * 7919 % 101) as f64 / 50.0 - 1.0);
+            let (sa, fx) = if braking {
+                (0.0, -1200.0 * (std::f64::consts::PI * u).sin())
+            } else {
+                (8.0 * (std::f64::consts::TAU * u).sin(), fx0 + noise)
+            };
+            // SAE: FY falls with SA (as TTC data), FZ negative when loaded.
+            t.push_str(&format!(
+                "{:.2}\t40\t{sa:.3}\t0\t83\t{fx:.1}\t{:.1}\t-1000\n",
+                0.01 * i as f64,
+                -150.0 * sa
+            ));
+            i += 1;
+        }
+    }
+    t
+}
+
+/// A recording that corners and brakes, shared without wheel speed or slip
+/// channel: the cornering blocks roll freely and keep κ = 0, the braking
+/// rows (whose slip nothing tells) are dropped with that reason, and a
+/// brake-only run is still refused.
+#[test]
+fn cornering_blocks_of_a_run_without_any_slip_keep_free_rolling() {
+    let t = ttc_without_slip(&[(20.0, false), (10.0, true), (20.0, false)], 0.0);
+    let l = load_str("mixed.dat", &t).unwrap();
+    assert!(
+        l.report
+            .kappa
+            .starts_with("κ = 0 on the freely rolling stretches"),
+        "{}",
+        l.report.kappa
+    );
+    let r = &l.recording;
+    assert!(r.samples.iter().all(|s| s.kappa == 0.0));
+    // The braking block's rows beyond the free-rolling band (|Fx| > 150 N
+    // of 1200: all but 2 × 0.4 s of its 10 s) are gone, the cornering rows stay.
+    let dropped = l.report.dropped_total;
+    assert!((900..=930).contains(&dropped), "{dropped} rows dropped");
+    assert!(l
+        .report
+        .dropped
+        .iter()
+        .any(|(why, n)| why.contains("kappa: unknown") && *n == dropped));
+    assert!(
+        r.samples.iter().all(|s| s.fx.abs() < 160.0),
+        "a braking row kept"
+    );
+    assert!(r.samples.iter().filter(|s| s.alpha.abs() > 0.02).count() > 3500);
+    // Brake-only: nothing rolls freely for 2 s; its sweeps hold near the
+    // peak for 4 s each, a dense band of Fx/Fz that must not pass for a
+    // free-rolling level.
+    let l = load_str(
+        "brake.dat",
+        &ttc_without_slip(&[(10.0, true), (10.0, true)], 0.0),
+    )
+    .unwrap();
+    assert!(l.report.kappa.starts_with("missing"), "{}", l.report.kappa);
+    assert_eq!(l.report.dropped_total, 0);
+}
+
+/// Free rolling is judged against the run's own free-rolling level: a tyre
+/// (or a force-sensor zero) with Fx at −9 % of Fz throughout — as one FSAE
+/// tyre of the dev set — still rolls freely (|Fx| < 10 % Fz had refused it).
+#[test]
+fn a_cornering_run_with_a_free_rolling_fx_offset_rolls_freely() {
+    let l = load_str("offset.dat", &ttc_without_slip(&[(30.0, false)], -90.0)).unwrap();
+    assert!(
+        l.report
+            .kappa
+            .starts_with("κ = 0: no wheel speed or slip channel"),
+        "{}",
+        l.report.kappa
+    );
+    assert_eq!(l.report.dropped_total, 0);
+    assert!(l.recording.samples.iter().all(|s| s.kappa == 0.0));
+}

@@ -69,6 +69,21 @@ pub fn load_all(paths: &[PathBuf], o: &LoadOptions, cmd: &str) -> Result<Vec<dat
         for r in &l.report.rejected {
             eprintln!("tyrekit {cmd}: warning: {}: {r}", p.display());
         }
+        if l.report.dropped_total > 0 {
+            let why: Vec<String> = l
+                .report
+                .dropped
+                .iter()
+                .map(|(r, n)| format!("{n} {r}"))
+                .collect();
+            eprintln!(
+                "tyrekit {cmd}: {}: {} of {} rows dropped ({}): see `tyrekit data summary`",
+                p.display(),
+                l.report.dropped_total,
+                l.report.rows_read,
+                why.join("; ")
+            );
+        }
         if !l.report.slip_reference.is_empty() {
             eprintln!(
                 "tyrekit {cmd}: {}: slip reference {}",

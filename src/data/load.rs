@@ -222,6 +222,9 @@ pub struct Loaded {
     pub report: LoadReport,
 }
 
+/// The loader's word when no slip ratio can be had.
+const KAPPA_MISSING: &str = "missing (no usable wheel speed / radius to compute it, no slip-ratio channel SR, and the run does not roll freely: drive/brake rows cannot be used)";
+
 fn rec_err(file: &str, location: impl Into<String>, message: impl Into<String>) -> Error {
     Error::Recording {
         file: file.to_string(),
@@ -696,6 +699,9 @@ pub fn from_raw(raw: RawTable, format: Format, file: &str, opts: &LoadOptions) -
         KappaSource::Recorded => false,
         KappaSource::Auto => !has_kappa,
     };
+    // Rows whose κ cannot be known (drive/brake rows without any slip
+    // information): dropped and counted below, with that reason.
+    let mut kappa_unknown: Option<Vec<bool>> = None;
     if want_computed {
         let re = extra
             .iter()
@@ -744,16 +750,37 @@ pub fn from_raw(raw: RawTable, format: Format, file: &str, opts: &LoadOptions) -
             {
                 samples.iter_mut().for_each(|s| s.kappa = 0.0);
                 channels.push("kappa".into());
-                report.kappa = if has(Ch::Omega) || has(Ch::Kappa) {
-                    "κ = 0: no usable wheel speed, and the run rolls freely (|Fx| < 10 % Fz on 95 % of the loaded rows)"
+                let why = if has(Ch::Omega) || has(Ch::Kappa) {
+                    "no usable wheel speed"
                 } else {
-                    "κ = 0: no wheel speed or slip channel recorded, and the run rolls freely (|Fx| < 10 % Fz on 95 % of the loaded rows)"
+                    "no wheel speed or slip channel recorded"
+                };
+                report.kappa = format!(
+                    "κ = 0: {why}, and the run rolls freely (Fx/Fz within {} of its free-rolling level on 95 % of the loaded rows)",
+                    sanity::FREE_ROLLING_FX
+                );
+            }
+            // Neither, on a recording that also drives and brakes: κ = 0
+            // where it rolls freely for seconds on end (its cornering
+            // blocks), and the drive/brake rows, whose slip is unknown, go.
+            None if !has_kappa => match sanity::free_rolling_stretches(&samples) {
+                Some(mask) => {
+                    for (s, &m) in samples.iter_mut().zip(&mask) {
+                        s.kappa = if m { 0.0 } else { f64::NAN };
+                    }
+                    channels.push("kappa".into());
+                    let free = mask.iter().filter(|m| **m).count();
+                    report.kappa = format!(
+                        "κ = 0 on the freely rolling stretches ({free} rows: Fx/Fz within {} of its free-rolling level for {} s or longer); no wheel speed or slip channel gives the slip of the other {} rows, which are dropped",
+                        sanity::FREE_ROLLING_FX,
+                        sanity::FREE_ROLLING_STRETCH_S,
+                        mask.len() - free
+                    );
+                    kappa_unknown = Some(mask);
                 }
-                .into();
-            }
-            None => {
-                report.kappa = "missing (no usable wheel speed / radius to compute it, no slip-ratio channel SR, and the run does not roll freely: drive/brake rows cannot be used)".into();
-            }
+                None => report.kappa = KAPPA_MISSING.into(),
+            },
+            None => report.kappa = KAPPA_MISSING.into(),
         }
     } else if has_kappa {
         report.kappa = "recorded channel".into();
@@ -786,7 +813,7 @@ pub fn from_raw(raw: RawTable, format: Format, file: &str, opts: &LoadOptions) -
     let mut checks = checks;
     for &(k, lo, hi) in checks.clone().iter() {
         let c = SAMPLE_CHANNELS[k];
-        if !sanity::REJECTABLE.contains(&c) {
+        if !sanity::REJECTABLE.contains(&c) || (c == "kappa" && kappa_unknown.is_some()) {
             continue;
         }
         let rows = samples
@@ -818,7 +845,13 @@ pub fn from_raw(raw: RawTable, format: Format, file: &str, opts: &LoadOptions) -
     }
     let mut counts = vec![0usize; SAMPLE_CHANNELS.len() * 2];
     let mut keep = vec![true; n];
+    let mut unknown_slip = 0usize;
     for (i, s) in samples.iter().enumerate() {
+        if kappa_unknown.as_ref().is_some_and(|m| !m[i]) {
+            unknown_slip += 1;
+            keep[i] = false;
+            continue;
+        }
         let v = s.values();
         for &(k, lo, hi) in &checks {
             let x = v[k];
@@ -851,6 +884,12 @@ pub fn from_raw(raw: RawTable, format: Format, file: &str, opts: &LoadOptions) -
                 counts[2 * k + 1],
             ));
         }
+    }
+    if unknown_slip > 0 {
+        report.dropped.push((
+            "kappa: unknown (driving or braking, and no wheel speed or slip channel)".into(),
+            unknown_slip,
+        ));
     }
     report.dropped_total = keep.iter().filter(|k| !**k).count();
     if report.dropped_total > 0 {

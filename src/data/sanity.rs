@@ -224,25 +224,145 @@ pub(crate) fn check_pinned_slip(
     report.extra_units.retain(|(n, _)| !remove.contains(n));
 }
 
-/// Whether the recording rolls freely throughout: no Fx channel, or |Fx|
-/// below 10 % of Fz on 95 % of the loaded rows (a cornering-only test:
-/// rolling resistance and the induced drag of a cornering tyre stay well
-/// below that; a drive/brake sweep to κ = 0.1 passes it).
-pub(crate) fn free_rolling_run(samples: &[Sample], has_fx: bool) -> bool {
-    if !has_fx {
-        return true;
-    }
+/// How far Fx/Fz may stray from the recording's free-rolling level on a
+/// freely rolling row: half the 2–98 % spread of Fx/Fz (0.3) beyond which
+/// the segmenter takes Fx for swept (`structure::make_segment`), so rows
+/// count as free rolling where a segment of them would not count as a
+/// slip-ratio sweep. A drive/brake sweep leaves the band at |κ| ≈ 0.006
+/// on car and FSAE tyres (slip stiffness 20–30 Fz per unit κ).
+pub(crate) const FREE_ROLLING_FX: f64 = 0.15;
+
+/// Shortest stretch (s) of free rolling inside a drive/brake recording
+/// (see [`free_rolling_stretches`]): a cornering sweep lasts far longer (a
+/// 4°/s sweep to ±12° takes over 10 s, TTC's several seconds), while a
+/// slip-ratio sweep crosses the free-rolling band in well under a second
+/// at any programmed rate (0.06 s at 0.1/s).
+pub(crate) const FREE_ROLLING_STRETCH_S: f64 = 2.0;
+
+/// Longest excursion (s) out of the free-rolling band that does not end a
+/// stretch: a noise spike at the lightest load, not a slip-ratio sweep
+/// (which stays out for seconds).
+const FREE_ROLLING_GAP_S: f64 = 0.25;
+
+/// Share of the loaded rows the free-rolling stretches must hold before a
+/// recording without any slip information is used on them alone: below
+/// it the recording is a drive/brake test whose dwells would be all that
+/// is left, and it is better refused with the reason.
+pub(crate) const FREE_ROLLING_SHARE: f64 = 0.25;
+
+/// The recording's free-rolling Fx/Fz: the median of the loaded rows in the
+/// densest band of width 2·[`FREE_ROLLING_FX`] among those within
+/// 2·[`FREE_ROLLING_FX`] of zero (a mode), held within ±[`FREE_ROLLING_FX`].
+/// Rolling resistance, the tyre's own Fx at κ = 0 and a force-sensor zero
+/// put it anywhere near 0 — 1–2 % of Fz for rolling resistance, −9 % on one
+/// FSAE tyre of the dev set —, and drive/brake rows spread far either side;
+/// the bound keeps a held brake force (a dense band near −1) from passing
+/// for it. `None` without loaded rows with Fx.
+fn free_rolling_level(samples: &[Sample]) -> Option<f64> {
     let fmax = max_abs_fz(samples);
     let mut r: Vec<f64> = samples
         .iter()
         .filter(|s| loaded(s, fmax) && s.fx.is_finite())
-        .map(|s| (s.fx / s.fz).abs())
+        .map(|s| s.fx / s.fz.abs())
         .collect();
     if r.is_empty() {
+        return None;
+    }
+    r.retain(|x| x.abs() <= 2.0 * FREE_ROLLING_FX);
+    r.sort_by(f64::total_cmp);
+    let (mut best, mut lo) = ((0, 0), 0);
+    for hi in 0..r.len() {
+        while r[hi] - r[lo] > 2.0 * FREE_ROLLING_FX {
+            lo += 1;
+        }
+        if hi + 1 - lo > best.1 - best.0 {
+            best = (lo, hi + 1);
+        }
+    }
+    let level = if best.1 > best.0 {
+        r[(best.0 + best.1) / 2]
+    } else {
+        0.0
+    };
+    Some(level.clamp(-FREE_ROLLING_FX, FREE_ROLLING_FX))
+}
+
+/// Whether the recording rolls freely throughout: no Fx channel, or Fx/Fz
+/// within [`FREE_ROLLING_FX`] of its free-rolling level on 95 % of the
+/// loaded rows (a cornering-only test: the induced drag of a cornering
+/// tyre and the noise at the lightest load stay within it; a drive/brake
+/// sweep to κ = 0.1 does not).
+pub(crate) fn free_rolling_run(samples: &[Sample], has_fx: bool) -> bool {
+    if !has_fx {
         return true;
     }
+    let Some(level) = free_rolling_level(samples) else {
+        return true;
+    };
+    let fmax = max_abs_fz(samples);
+    let mut r: Vec<f64> = samples
+        .iter()
+        .filter(|s| loaded(s, fmax) && s.fx.is_finite())
+        .map(|s| (s.fx / s.fz.abs() - level).abs())
+        .collect();
     r.sort_by(f64::total_cmp);
-    r[(r.len() * 95 / 100).min(r.len() - 1)] < 0.1
+    r[(r.len() * 95 / 100).min(r.len() - 1)] < FREE_ROLLING_FX
+}
+
+/// Per row, whether it lies in a stretch of at least
+/// [`FREE_ROLLING_STRETCH_S`] over which the loaded rows hold Fx/Fz within
+/// [`FREE_ROLLING_FX`] of the free-rolling level (excursions up to
+/// [`FREE_ROLLING_GAP_S`] bridged): the cornering blocks and dwells of a
+/// recording that also brakes and drives, where κ = 0 is known without a
+/// wheel speed. `None` when such stretches hold less than
+/// [`FREE_ROLLING_SHARE`] of the loaded rows. A stretch ends where time
+/// does not advance.
+pub(crate) fn free_rolling_stretches(samples: &[Sample]) -> Option<Vec<bool>> {
+    let level = free_rolling_level(samples)?;
+    let fmax = max_abs_fz(samples);
+    let free = |s: &Sample| {
+        !loaded(s, fmax)
+            || (s.fx.is_finite() && (s.fx / s.fz.abs() - level).abs() < FREE_ROLLING_FX)
+    };
+    let n = samples.len();
+    // Runs of rows (start, end) in the band, excursions up to the gap bridged.
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    let mut i = 0;
+    while i < n {
+        if !free(&samples[i]) {
+            i += 1;
+            continue;
+        }
+        let mut j = i + 1;
+        while j < n && free(&samples[j]) && samples[j].time > samples[j - 1].time {
+            j += 1;
+        }
+        match runs.last_mut() {
+            Some(last)
+                if samples[i].time > samples[last.1 - 1].time
+                    && samples[i].time - samples[last.1 - 1].time <= FREE_ROLLING_GAP_S
+                    && samples[last.1..i].windows(2).all(|w| w[1].time > w[0].time) =>
+            {
+                last.1 = j
+            }
+            _ => runs.push((i, j)),
+        }
+        i = j;
+    }
+    let mut mask = vec![false; n];
+    for (a, b) in runs {
+        if samples[b - 1].time - samples[a].time >= FREE_ROLLING_STRETCH_S {
+            mask[a..b].iter_mut().for_each(|m| *m = true);
+        }
+    }
+    let (mut total, mut kept) = (0usize, 0usize);
+    for (s, &m) in samples.iter().zip(&mask) {
+        if loaded(s, fmax) {
+            total += 1;
+            kept += usize::from(m);
+        }
+    }
+    (total > 0 && kept as f64 >= FREE_ROLLING_SHARE * total as f64).then_some(mask)
 }
 
 /// Sign and unit slips that make every later number wrong: stop with the

@@ -231,6 +231,15 @@ pub fn time_drift_in_words(d: &super::factor::TimeDrift) -> String {
     )
 }
 
+/// What a recording with gaps in its time cannot follow, in words
+/// (`factor::missing_time`: `gap` s missing, `share` of the run).
+pub fn missing_time_in_words(gap: f64, share: f64) -> String {
+    format!(
+        "{gap:.0} s of the run ({:.0} %) are not in the data (rows dropped on loading or not recorded: see `tyrekit data summary`), so an effect that builds up over the run (tread temperature, wear) cannot be followed across those gaps: it may be present though none is named.",
+        100.0 * share
+    )
+}
+
 /// " PPY3 = -3 (its lower bound) is at a bound of its range: …", or "".
 pub(crate) fn at_bound_note(e: &Evaluation) -> String {
     if e.at_bound.is_empty() {

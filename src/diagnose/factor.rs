@@ -178,6 +178,40 @@ pub struct TimeDrift {
     pub r: f64,
 }
 
+/// Gaps in a recording's time: a step longer than this many median sample
+/// intervals is time the data do not cover (rows dropped on loading, a
+/// logger pause), not jitter of the sample clock.
+const GAP_STEPS: f64 = 5.0;
+
+/// Share of the run's time that must be missing before
+/// [`missing_time`] reports it: a few dropped rows do not hide a history.
+const MISSING_SHARE: f64 = 0.05;
+
+/// Time (s) of the run the samples do not cover, and its share of the run:
+/// the steps longer than five median intervals (less one interval
+/// each), where time advances. `None` below 5 % of the run.
+/// A state built up over the run (a tread temperature) cannot be followed
+/// across such gaps.
+pub fn missing_time(samples: &[Sample]) -> Option<(f64, f64)> {
+    let mut dt: Vec<f64> = samples
+        .windows(2)
+        .map(|w| w[1].time - w[0].time)
+        .filter(|d| d.is_finite() && *d > 0.0)
+        .collect();
+    if dt.len() < 2 {
+        return None;
+    }
+    let run: f64 = dt.iter().sum();
+    dt.sort_by(f64::total_cmp);
+    let step = dt[dt.len() / 2];
+    let gaps: f64 = dt
+        .iter()
+        .filter(|d| **d > GAP_STEPS * step)
+        .map(|d| d - step)
+        .sum();
+    (gaps >= MISSING_SHARE * run).then_some((gaps, gaps / run))
+}
+
 /// `Some` when `get` varies over `segments` beyond its noise
 /// ([`varies_beyond_noise`]) and its segment means follow the segments'
 /// mid-times with |correlation| ≥ [`TIME_CONFOUNDED_R`]; `None` otherwise
@@ -218,6 +252,46 @@ pub fn drift_with_time(
 mod tests {
     use super::*;
     use crate::data::SegmentKind;
+
+    /// Rows dropped from the middle of a run are time it does not cover;
+    /// a jittering sample clock, a few dropped rows or a clock restarting
+    /// for a second run are not.
+    #[test]
+    fn time_a_run_does_not_cover_is_found() {
+        let at = |t: &[f64]| -> Vec<Sample> {
+            t.iter()
+                .map(|&time| Sample {
+                    time,
+                    ..Default::default()
+                })
+                .collect()
+        };
+        let steady: Vec<f64> = (0..10_000).map(|i| 0.01 * i as f64).collect();
+        assert_eq!(missing_time(&at(&steady)), None);
+        let jitter: Vec<f64> = (0..10_000)
+            .map(|i| 0.01 * i as f64 + if i % 2 == 0 { 0.002 } else { 0.0 })
+            .collect();
+        assert_eq!(missing_time(&at(&jitter)), None);
+        // 30 s of 100 taken out of the middle, and a separate 1 s.
+        let cut: Vec<f64> = steady
+            .iter()
+            .copied()
+            .filter(|t| !(40.0..70.0).contains(t) && !(80.0..81.0).contains(t))
+            .collect();
+        let (gap, share) = missing_time(&at(&cut)).expect("gaps");
+        assert!((gap - 31.0).abs() < 0.05, "{gap}");
+        assert!((share - 0.31).abs() < 0.005, "{share}");
+        // 2 s of 100 are under the 5 % that hides a history.
+        let few: Vec<f64> = steady
+            .iter()
+            .copied()
+            .filter(|t| !(40.0..42.0).contains(t))
+            .collect();
+        assert_eq!(missing_time(&at(&few)), None);
+        // Two runs one after the other, each with its clock from 0.
+        let restarted: Vec<f64> = steady.iter().map(|t| t % 50.0).collect();
+        assert_eq!(missing_time(&at(&restarted)), None);
+    }
 
     fn seg(start: usize, end: usize) -> Segment {
         Segment {

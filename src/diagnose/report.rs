@@ -442,10 +442,19 @@ pub fn diagnose_with(
     let misfit = misfit_note(&base_fit);
     // What the recording cannot tell apart when nothing is named: a recorded
     // pressure that moves with time in the run alone.
+    // Or time the data do not cover (a history cannot be followed).
     let unseparable = if verdict_i.is_none() && !slip_verdict {
         let segs: Vec<&crate::data::Segment> = rec.segments.iter().collect();
-        super::factor::drift_with_time(&rec.samples, &segs, |s| s.p)
-            .map(|d| super::explain::time_drift_in_words(&d))
+        let words: Vec<String> = [
+            super::factor::drift_with_time(&rec.samples, &segs, |s| s.p)
+                .map(|d| super::explain::time_drift_in_words(&d)),
+            super::factor::missing_time(&rec.samples)
+                .map(|(gap, share)| super::explain::missing_time_in_words(gap, share)),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        (!words.is_empty()).then(|| words.join(" Also, "))
     } else {
         None
     };

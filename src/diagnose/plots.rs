@@ -262,15 +262,10 @@ const MAX_PANELS: usize = 6;
 /// new level where a load is not [`same_load_level`] as the last level's first
 /// load; each level its first (lightest) load.
 fn load_levels(fz: impl Iterator<Item = f64>) -> Vec<f64> {
-    let mut v: Vec<f64> = fz.filter(|x| x.is_finite()).collect();
-    v.sort_by(f64::total_cmp);
-    let mut levels: Vec<f64> = Vec::new();
-    for x in v {
-        if levels.last().is_none_or(|&l| !same_load_level(l, x)) {
-            levels.push(x);
-        }
-    }
-    levels
+    crate::stats::anchored_levels(fz, |x| *x, same_load_level)
+        .into_iter()
+        .map(|l| l[0])
+        .collect()
 }
 
 /// Common y range of several point sets (robust: 0.5 % / 99.5 % quantiles,

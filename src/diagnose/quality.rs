@@ -64,27 +64,20 @@ pub(crate) fn ranges(mask: &[bool]) -> Vec<Range<usize>> {
 /// level, with their indices.
 fn speed_levels(rec: &Recording) -> Vec<(f64, Vec<usize>)> {
     let t = SegmentOptions::default();
-    let mut order: Vec<usize> = (0..rec.segments.len())
-        .filter(|&k| rec.segments[k].vx.is_finite())
-        .collect();
-    order.sort_by(|&a, &b| rec.segments[a].vx.total_cmp(&rec.segments[b].vx));
-    let mut levels: Vec<(f64, Vec<usize>)> = Vec::new();
-    for k in order {
-        let v = rec.segments[k].vx;
-        match levels.last_mut() {
-            Some((anchor, m)) if v - *anchor <= t.v_abs.max(t.v_rel * v.abs()) => m.push(k),
-            _ => levels.push((v, vec![k])),
-        }
-    }
-    levels
-        .into_iter()
-        .map(|(_, m)| {
-            let w = |k: &usize| rec.segments[*k].len().max(1) as f64;
-            let total: f64 = m.iter().map(w).sum();
-            let v = m.iter().map(|k| w(k) * rec.segments[*k].vx).sum::<f64>() / total;
-            (v, m)
-        })
-        .collect()
+    let segs = &rec.segments;
+    crate::stats::anchored_levels(
+        0..segs.len(),
+        |&k| segs[k].vx,
+        |anchor, v| v - anchor <= t.v_abs.max(t.v_rel * v.abs()),
+    )
+    .into_iter()
+    .map(|m| {
+        let w = |k: &usize| segs[*k].len().max(1) as f64;
+        let total: f64 = m.iter().map(w).sum();
+        let v = m.iter().map(|k| w(k) * segs[*k].vx).sum::<f64>() / total;
+        (v, m)
+    })
+    .collect()
 }
 
 /// One row of the quality table.

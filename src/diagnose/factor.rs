@@ -178,38 +178,28 @@ pub struct TimeDrift {
     pub r: f64,
 }
 
-/// Gaps in a recording's time: a step longer than this many median sample
-/// intervals is time the data do not cover (rows dropped on loading, a
-/// logger pause), not jitter of the sample clock.
-const GAP_STEPS: f64 = 5.0;
-
 /// Share of the run's time that must be missing before
 /// [`missing_time`] reports it: a few dropped rows do not hide a history.
 const MISSING_SHARE: f64 = 0.05;
 
 /// Time (s) of the run the samples do not cover, and its share of the run:
-/// the steps longer than five median intervals (less one interval
-/// each), where time advances. `None` below 5 % of the run.
-/// A state built up over the run (a tread temperature) cannot be followed
-/// across such gaps.
+/// the steps the replay takes for gaps (longer than
+/// `ReplayOptions::gap_factor`, five, median intervals; it resets the
+/// transient state there), less one interval each, where time advances.
+/// `None` below 5 % of the run. A state built up over the run (a tread
+/// temperature) cannot be followed across such gaps.
 pub fn missing_time(samples: &[Sample]) -> Option<(f64, f64)> {
-    let mut dt: Vec<f64> = samples
+    use crate::residual::{median_spacing, ReplayOptions};
+    let t: Vec<f64> = samples.iter().map(|s| s.time).collect();
+    let step = median_spacing(&t);
+    let gap = ReplayOptions::default().gap_factor * step;
+    let dt = t
         .windows(2)
-        .map(|w| w[1].time - w[0].time)
-        .filter(|d| d.is_finite() && *d > 0.0)
-        .collect();
-    if dt.len() < 2 {
-        return None;
-    }
-    let run: f64 = dt.iter().sum();
-    dt.sort_by(f64::total_cmp);
-    let step = dt[dt.len() / 2];
-    let gaps: f64 = dt
-        .iter()
-        .filter(|d| **d > GAP_STEPS * step)
-        .map(|d| d - step)
-        .sum();
-    (gaps >= MISSING_SHARE * run).then_some((gaps, gaps / run))
+        .map(|w| w[1] - w[0])
+        .filter(|d| d.is_finite() && *d > 0.0);
+    let run: f64 = dt.clone().sum();
+    let gaps: f64 = dt.filter(|d| *d > gap).map(|d| d - step).sum();
+    (step.is_finite() && gaps >= MISSING_SHARE * run).then_some((gaps, gaps / run))
 }
 
 /// `Some` when `get` varies over `segments` beyond its noise

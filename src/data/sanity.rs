@@ -225,12 +225,12 @@ pub(crate) fn check_pinned_slip(
 }
 
 /// How far Fx/Fz may stray from the recording's free-rolling level on a
-/// freely rolling row: half the 2–98 % spread of Fx/Fz (0.3) beyond which
-/// the segmenter takes Fx for swept (`structure::make_segment`), so rows
+/// freely rolling row: half the 2–98 % spread of Fx/Fz beyond which the
+/// segmenter takes Fx for swept ([`super::structure::FX_SWEPT`]), so rows
 /// count as free rolling where a segment of them would not count as a
 /// slip-ratio sweep. A drive/brake sweep leaves the band at |κ| ≈ 0.006
 /// on car and FSAE tyres (slip stiffness 20–30 Fz per unit κ).
-pub(crate) const FREE_ROLLING_FX: f64 = 0.15;
+pub(crate) const FREE_ROLLING_FX: f64 = 0.5 * super::structure::FX_SWEPT;
 
 /// Shortest stretch (s) of free rolling inside a drive/brake recording
 /// (see [`free_rolling_stretches`]): a cornering sweep lasts far longer (a

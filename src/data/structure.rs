@@ -212,6 +212,25 @@ fn assign(x: f64, lv: &[f64], tol: &dyn Fn(f64) -> f64) -> Option<u16> {
     ((x - l).abs() <= lim).then_some(k as u16)
 }
 
+/// Slip-angle spread (rad, 2–98 %) beyond which α counts as swept: 2°, a
+/// small fraction of any cornering sweep, well above a held set point's
+/// sensor noise and steering play.
+const ALPHA_SWEPT: f64 = 2.0 * std::f64::consts::PI / 180.0;
+
+/// Slip-ratio spread (2–98 %) beyond which κ counts as swept: 0.03, several
+/// times the scatter of a freely rolling wheel's κ and a fraction of any
+/// slip-ratio sweep (to ±0.1 … ±0.2).
+const KAPPA_SWEPT: f64 = 0.03;
+
+/// Spread of Fx/Fz (2–98 %) beyond which Fx counts as swept where κ is
+/// unknown: 0.3, the Fx/Fz a κ spread of [`KAPPA_SWEPT`] gives at a slip
+/// stiffness of 10 Fz per unit κ; at the 20–30 Fz of car and FSAE tyres a κ
+/// spread of 0.010–0.015 already reaches it, so no sweep is missed for want
+/// of κ.
+/// Free rolling is judged against half of it
+/// ([`super::sanity::FREE_ROLLING_FX`]).
+pub(crate) const FX_SWEPT: f64 = 0.3;
+
 /// Robust spread: 98th − 2nd percentile.
 fn spread(x: impl Iterator<Item = f64>) -> f64 {
     let mut v: Vec<f64> = x.filter(|v| v.is_finite()).collect();
@@ -360,9 +379,9 @@ fn split_by_alpha_setpoint(
         .iter()
         .filter(|x| strict_assign(**x, &lv, o.alpha_tol).is_some())
         .count();
-    let kappa_swept = spread(s[a..b].iter().map(|x| x.kappa)) > 0.03
-        || spread(s[a..b].iter().map(|x| x.fx / x.fz.max(1.0))) > 0.3
-            && spread(al.iter().copied()) < 2f64.to_radians();
+    let kappa_swept = spread(s[a..b].iter().map(|x| x.kappa)) > KAPPA_SWEPT
+        || spread(s[a..b].iter().map(|x| x.fx / x.fz.max(1.0))) > FX_SWEPT
+            && spread(al.iter().copied()) < ALPHA_SWEPT;
     if !lv.is_empty() && kappa_swept && on as f64 > 0.8 * (b - a) as f64 {
         // Runs of one α set point (strict tolerance); samples off every set
         // point (α ramping between them) belong to no segment.
@@ -397,15 +416,14 @@ fn make_segment(s: &[Sample], a: usize, b: usize, o: &SegmentOptions) -> Segment
     let seg = &s[a..b];
     let a_spread = spread(seg.iter().map(|x| x.alpha));
     let has_kappa = seg.iter().any(|x| x.kappa.is_finite());
-    let k_spread = if has_kappa {
-        spread(seg.iter().map(|x| x.kappa))
+    let kappa_swept = if has_kappa {
+        spread(seg.iter().map(|x| x.kappa)) > KAPPA_SWEPT
     } else {
         // Without κ, a swept Fx at fixed α stands for a slip-ratio sweep.
-        spread(seg.iter().map(|x| x.fx / x.fz.max(1.0))) * 0.1
+        spread(seg.iter().map(|x| x.fx / x.fz.max(1.0))) > FX_SWEPT
     };
     let alpha_med = med_of(seg, |x| x.alpha);
-    let alpha_swept = a_spread > 2f64.to_radians();
-    let kappa_swept = k_spread > 0.03;
+    let alpha_swept = a_spread > ALPHA_SWEPT;
     let kind = match (alpha_swept, kappa_swept) {
         (true, false) => SegmentKind::PureLateral,
         (false, true) if alpha_med.abs() <= o.alpha_tol => SegmentKind::PureLongitudinal,
@@ -501,7 +519,7 @@ pub fn detect_warmup(s: &[Sample], segs: &[Segment]) -> Option<(usize, String)> 
     if why.is_empty() {
         // Samples before the first segment: warm-up only if they contain sweeps.
         let g = &segs[0];
-        if g.start > 0 && spread(s[..g.start].iter().map(|x| x.alpha)) > 2f64.to_radians() {
+        if g.start > 0 && spread(s[..g.start].iter().map(|x| x.alpha)) > ALPHA_SWEPT {
             return Some((
                 g.start,
                 "slip sweeps before the first set-point segment".into(),

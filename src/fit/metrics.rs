@@ -162,7 +162,7 @@ pub fn condition_groups(rec: &Recording) -> Vec<ConditionGroup> {
             None => groups.push((c, vec![i])),
         }
     }
-    let mut out: Vec<ConditionGroup> = groups
+    let out: Vec<ConditionGroup> = groups
         .into_iter()
         .map(|(_, mut members)| {
             members.sort_unstable();
@@ -192,24 +192,25 @@ pub fn condition_groups(rec: &Recording) -> Vec<ConditionGroup> {
         })
         .collect();
     // Order by load level (the loads of one level differ by a few newtons
-    // between inclinations), then inclination, then pressure.
-    out.sort_by(|a, b| a.condition.order(&b.condition));
-    let mut level = Vec::with_capacity(out.len());
-    let mut anchor = f64::NAN;
-    for g in &out {
-        let fz = g.condition.fz;
-        if !same_load_level(anchor, fz) {
-            anchor = fz;
-        }
-        level.push(anchor);
-    }
-    let mut keyed: Vec<(f64, ConditionGroup)> = level.into_iter().zip(out).collect();
-    keyed.sort_by(|(la, a), (lb, b)| {
-        la.total_cmp(lb)
-            .then(a.condition.gamma.total_cmp(&b.condition.gamma))
-            .then(a.condition.p.total_cmp(&b.condition.p))
-    });
-    keyed.into_iter().map(|(_, g)| g).collect()
+    // between inclinations), then inclination, then pressure; conditions
+    // without a load last.
+    let (loaded, unloaded): (Vec<_>, Vec<_>) =
+        out.into_iter().partition(|g| g.condition.fz.is_finite());
+    let mut ordered: Vec<ConditionGroup> =
+        crate::stats::anchored_levels(loaded, |g| g.condition.fz, same_load_level)
+            .into_iter()
+            .flat_map(|mut level| {
+                level.sort_by(|a, b| {
+                    a.condition
+                        .gamma
+                        .total_cmp(&b.condition.gamma)
+                        .then(a.condition.p.total_cmp(&b.condition.p))
+                });
+                level
+            })
+            .collect();
+    ordered.extend(unloaded);
+    ordered
 }
 
 /// Distinct conditions of a recording ([`condition_groups`] without the members).

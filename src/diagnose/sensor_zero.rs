@@ -61,10 +61,6 @@ use crate::tir::TyreParams;
 /// from three.
 pub const MIN_LOAD_LEVELS: usize = 3;
 
-/// Two segment loads closer than this fraction of the largest one are the
-/// same level (rig load control wanders by a few per cent).
-const LEVEL_TOLERANCE: f64 = 0.05;
-
 /// Smallest relative fall of a channel's fitted σ (the MF without the
 /// zeros on the recording without them, against the first fit on the
 /// recording as measured) for the diagnosis to compare with the fit
@@ -242,19 +238,12 @@ pub fn estimate(
     Ok(out)
 }
 
-/// Distinct levels among segment loads (N): sorted, a new level where the
-/// next load lies more than [`LEVEL_TOLERANCE`] of the largest above the
-/// previous one.
+/// Distinct levels among segment loads (N), by the rule the quality tables
+/// group conditions with ([`crate::fit::metrics::same_load_level`]: rig load
+/// control wanders by a few per cent, set points differ by ≥ 30 %).
 fn load_levels(fz: impl Iterator<Item = f64>) -> usize {
-    let mut v: Vec<f64> = fz.filter(|f| f.is_finite() && *f > 0.0).collect();
-    v.sort_by(f64::total_cmp);
-    let Some(&max) = v.last() else {
-        return 0;
-    };
-    1 + v
-        .windows(2)
-        .filter(|w| w[1] - w[0] > LEVEL_TOLERANCE * max)
-        .count()
+    let loaded = fz.filter(|f| *f > 0.0);
+    crate::stats::anchored_levels(loaded, |f| *f, crate::fit::metrics::same_load_level).len()
 }
 
 /// A copy of `rec` with the estimated zeros subtracted from its Fx, Fy and

@@ -165,12 +165,12 @@ pub fn explain(
     };
     match verdict {
         Some(e) => format!(
-            "{}. Missing from the model: {}. {} removes {:.0} % of the baseline's error on held-out segments (each channel's squared error: {}; BIC {:+.1}).{}",
+            "{}. Missing from the model: {}. Fitted: {}. This removes {:.0} % of the baseline's error on held-out segments (each channel's squared error: {}; BIC {:+.1}).{}",
             capitalise(located.as_deref().unwrap_or(
                 "no single grouping of the residual is significant on its own"
             )),
             e.physics,
-            capitalise(&e.describe),
+            e.describe,
             100.0 * e.oos_gain,
             channels_in_words(e),
             e.delta_bic,

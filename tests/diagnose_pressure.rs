@@ -233,6 +233,16 @@ fn stiffness_law_is_named_pressure_with_stiffness_terms() {
         let (df, ds) = (fitted(&d, f) - base(f), fitted(&d, s) - base(s));
         assert!(df.abs() < 0.5 * ds.abs(), "{f} moved {df:.3}, {s} {ds:.3}");
     }
+    // The words state the fitted law in kPa: Kyα ∝ (1 + PPY1·dpi) at
+    // dpi = 10 kPa / NOMPRES (Pacejka, eq. 4.E25, 4.E2b).
+    let p0 = base("NOMPRES");
+    let at = format!("at +10 kPa over {:.0} kPa", p0 / 1e3);
+    let ky = format!(
+        "Fy cornering stiffness {:+.1} %",
+        100.0 * 10e3 / p0 * fitted(&d, "PPY1")
+    );
+    let e = d.explanation();
+    assert!(e.contains(&at) && e.contains(&ky), "{at} / {ky}: {e}");
 }
 
 #[test]

@@ -9,7 +9,7 @@
 //!   (1 + PPY3·dpi) (eq. 4.E23, PPY4 = 0);
 //! * PPZ1: the pneumatic trail Dt ∝ (1 − PPZ1·dpi) (eq. 4.E42);
 //!
-//! dpi = (p − p0)/p0, p0 = INFLPRES. The quadratic terms PPX4, PPY4 are not
+//! dpi = (p − p0)/p0, p0 = NOMPRES (eq. 4.E2b). The quadratic terms PPX4, PPY4 are not
 //! fitted: a drift of a few % of the pressure cannot tell a curvature from
 //! a slope (on r04 of the dev set they ended at their bounds), and the
 //! linear law is what a pressure set point ±15 % supports as well.
@@ -55,14 +55,36 @@ fn pressure_spec(t: &Tyre, _: &ReplayOptions) -> Option<Spec> {
     })
 }
 
-/// The fitted law in words at ±`pct` % of the pressure.
+/// Pressure step (Pa) the fitted law is stated at: 10 kPa, the unit of a
+/// tyre engineer's pressure sweep, within the span of a set-point ladder
+/// or a drift on car and FSAE tyres alike (a 10 % step would state a car
+/// tyre's drift of a few % far outside what was recorded).
+const WORDS_STEP: f64 = 10e3;
+
+/// The fitted law in words at +[`WORDS_STEP`] over the file's nominal
+/// pressure (NOMPRES, whose share dpi the terms multiply).
 fn words(f: &dyn super::Fitted) -> String {
-    let pct = 10.0;
+    let p0 = f.tyre().params().get("NOMPRES").filter(|p| *p > 0.0);
+    let (dpi, at) = match p0 {
+        Some(p0) => (
+            WORDS_STEP / p0,
+            format!(
+                "at +{:.0} kPa over {:.0} kPa (+{:.1} %)",
+                WORDS_STEP / 1e3,
+                p0 / 1e3,
+                100.0 * WORDS_STEP / p0
+            ),
+        ),
+        None => (0.1, "at +10 % inflation pressure".to_string()),
+    };
     let mut parts = Vec::new();
     let mut term = |k: &str, what: &str, sign: f64| {
         let v = param(f, k);
         if v.is_finite() {
-            parts.push(format!("{what} {:+.1} % ({k} = {v:.3})", sign * pct * v));
+            parts.push(format!(
+                "{what} {:+.1} % ({k} = {v:.3})",
+                sign * 100.0 * dpi * v
+            ));
         }
     };
     term("PPX1", "Fx slip stiffness", 1.0);
@@ -74,7 +96,7 @@ fn words(f: &dyn super::Fitted) -> String {
     if parts.is_empty() {
         return "no pressure term fitted".into();
     }
-    format!("at +{pct:.0} % inflation pressure: {}", parts.join(", "))
+    format!("{at}: {}", parts.join(", "))
 }
 
 /// The candidate.

@@ -496,7 +496,7 @@ pub fn diagnose_with(
     explanation.push_str(&w);
     if let Some(w) = &slip_words {
         explanation = if slip_verdict {
-            format!("{w} (The force residuals alone name nothing: {explanation})")
+            format!("{w} (The force residuals alone name nothing. {explanation})")
         } else {
             format!("{explanation} Also: {w}")
         };

@@ -122,7 +122,7 @@ pub(super) fn candidate() -> ParamCandidate {
                 )
             };
             format!(
-                "friction {:+.1} % at 1 m/s sliding speed, {:+.1} % at 3 m/s against its level at zero sliding speed, {:+.1} % of it at high sliding speed (DMU = {:.3}, VC = {:.2} m/s, VREF = {:.2} m/s); {reference}",
+                "against its level at zero sliding speed, friction {:+.1} % at 1 m/s sliding speed, {:+.1} % at 3 m/s and {:+.1} % at high sliding speed (DMU = {:.3}, VC = {:.2} m/s, VREF = {:.2} m/s); {reference}",
                 g(1.0),
                 g(3.0),
                 -100.0 * l.dmu,

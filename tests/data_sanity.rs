@@ -212,3 +212,89 @@ fn tydex_dead_wheel_speed_and_pinned_slip() {
     assert!(rejected(&l, "kappa"), "{:?}", l.report.rejected);
     check_dead_wheel_speed(&l, plan_lateral, "TYDEX");
 }
+
+/// A short full programme (cornering and drive/brake blocks) of `tyre`: three
+/// loads, upright, one pressure, no warm-up.
+fn full_run(tyre: &Tyre, seed: u64) -> RigRun {
+    let mut cfg = RigConfig::standard(tyre, seed);
+    let p = &mut cfg.programme;
+    p.pressures = vec![p.pressures[1]];
+    p.inclinations = vec![0.0];
+    p.db_alphas.truncate(2);
+    p.loads = vec![4000.0, 2000.0, 6000.0];
+    p.warmup = None;
+    simulate(&cfg, &mut SteadyMf::new(tyre.clone()))
+}
+
+/// A force channel that does not follow its slip is a dead load cell (or
+/// one in a unit far larger than its label) and is rejected by name, rows
+/// kept: an FX that reads a 30 N zero and ±10 N of noise through the
+/// drive/brake sweeps to κ = ±0.2, and an FY written in kN under an `N`
+/// label (values 1000× too small). Fitted, either would give a tyre
+/// without that force, and a diagnosis would read the channel's noise.
+#[test]
+fn a_force_channel_that_does_not_follow_its_slip_is_rejected() {
+    let run = full_run(&Tyre::builtin(), 11);
+    let mut dead_fx = run.clone();
+    for (i, x) in col(&mut dead_fx, "FX").iter_mut().enumerate() {
+        *x = 30.0 + 10.0 * (((i * 7919) % 201) as f64 / 100.0 - 1.0);
+    }
+    let mut kn_fy = run;
+    col(&mut kn_fy, "FY").iter_mut().for_each(|x| *x /= 1000.0);
+    for (r, dead, live) in [(dead_fx, "Fx", "Fy"), (kn_fy, "Fy", "Fx")] {
+        let p = tmp(&format!("dead_{dead}.dat"));
+        r.write_dat(&p).unwrap();
+        let l = read(&p);
+        assert!(
+            rejected(&l, dead),
+            "{dead} not rejected: {:?}",
+            l.report.rejected
+        );
+        let why = l.report.rejected.join(" ");
+        assert!(why.contains("does not follow the slip"), "{why}");
+        assert!(!l.recording.has(dead), "{dead} still listed");
+        assert!(
+            l.recording.has(live) && l.recording.has("Mz"),
+            "{live} or Mz lost"
+        );
+        assert!(!rejected(&l, live), "{live} rejected: {why}");
+        assert_eq!(l.report.dropped_total, 0, "{:?}", l.report.dropped);
+    }
+}
+
+/// The control: a tyre on ice — the built-in tyre's peak friction scaled
+/// to 6 % (LMUX = LMUY = 0.06: |F| ≤ 0.06–0.08 Fz) — keeps both force
+/// channels, as does the same programme at normal friction. The rule's
+/// bound (0.02 between the two sides of the slip) lies a factor five below
+/// what ice gives.
+#[test]
+fn force_channels_of_a_tyre_on_ice_are_kept() {
+    let mut ice = tyrekit::tir::TyreParams::builtin();
+    ice.set("LMUX", 0.06).unwrap();
+    ice.set("LMUY", 0.06).unwrap();
+    for (t, what) in [(Tyre::new(ice).unwrap(), "ice"), (Tyre::builtin(), "dry")] {
+        let p = tmp(&format!("forces_{what}.dat"));
+        full_run(&t, 12).write_dat(&p).unwrap();
+        let l = read(&p);
+        assert!(
+            l.report.rejected.is_empty(),
+            "{what}: {:?}",
+            l.report.rejected
+        );
+        assert!(l.recording.has("Fx") && l.recording.has("Fy"), "{what}");
+        // The recording does carry the ice's small forces: the rule passed
+        // a channel with |F|/Fz ≤ 0.1, not a large one.
+        let peak = l
+            .recording
+            .samples
+            .iter()
+            .filter(|s| s.fz > 1000.0)
+            .map(|s| (s.fx / s.fz).abs().max((s.fy / s.fz).abs()))
+            .fold(0.0f64, f64::max);
+        if what == "ice" {
+            assert!(peak < 0.15, "ice: peak |F|/Fz {peak}");
+        } else {
+            assert!(peak > 0.8, "dry: peak |F|/Fz {peak}");
+        }
+    }
+}

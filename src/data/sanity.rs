@@ -4,7 +4,8 @@
 //! Two kinds of finding:
 //! - **A broken channel** (a dead or absurd wheel speed, an effective radius
 //!   outside a physical range of the loaded radius, a slip ratio pinned at −1
-//!   while the tyre carries lateral force, a moment channel mostly out of
+//!   while the tyre carries lateral force, a force channel that does not
+//!   follow its slip (a dead load cell), a moment channel mostly out of
 //!   range or saturated) is *rejected*: its values become NaN, it leaves the
 //!   recording's channel list, and a warning naming it goes into
 //!   [`LoadReport::rejected`]. The rows stay.
@@ -222,6 +223,101 @@ pub(crate) fn check_pinned_slip(
     }
     extra.retain(|(n, _)| !remove.contains(n));
     report.extra_units.retain(|(n, _)| !remove.contains(n));
+}
+
+/// Smallest difference of the median F/Fz between the rows slipping one
+/// way and the rows slipping the other (`check_dead_forces`) that a live
+/// force channel shows. A tyre at |κ| ≥ 0.05 or |α| ≥ 3° carries at least
+/// min(slip stiffness · slip, μ)·Fz of force: slip stiffnesses of 5–30 Fz
+/// per unit slip and a friction of 0.05 or more even on ice give a
+/// difference of 0.1 or more between the two sides; 0.02 leaves a factor
+/// five below that, while a dead, disconnected or constant channel — or one
+/// in a unit a thousand times larger than its label (kN read as N) —
+/// differs by noise only.
+pub const DEAD_FORCE: f64 = 0.02;
+
+/// Slip beyond which, either side of its recording's median, a row counts
+/// as slipping for [`check_dead_forces`]: κ 0.05 (a drive/brake sweep of
+/// ±0.1 or more passes it for seconds) and α 3° (every cornering sweep
+/// passes it; a steer of 3° is past the linear range on no tyre).
+const DEAD_KAPPA: f64 = 0.05;
+const DEAD_ALPHA_DEG: f64 = 3.0;
+
+/// Fewest loaded rows on each side of the slip before a force channel is
+/// judged dead: a median of 20 values is not moved by a few spikes, and a
+/// steady-state TYDEX sweep of a few points per side is left unjudged.
+const DEAD_MIN_ROWS: usize = 20;
+
+/// Force channels that do not follow their slip: Fx against κ, Fy against
+/// α. On the loaded rows with finite values, the rows at slip ≥ median +
+/// threshold and ≤ median − threshold (κ 0.05, α 3°) are compared; where
+/// both sides hold [`DEAD_MIN_ROWS`] rows and their median F/Fz differ by
+/// less than [`DEAD_FORCE`], the channel is rejected with the figures (a
+/// dead or disconnected load cell, or a unit slip of a factor 1000): fitted,
+/// it would give a tyre without that force and any verdict read from it
+/// would be the channel's noise. A recording whose slip is never swept both
+/// ways leaves the channel unjudged. Runs after κ is known.
+pub(crate) fn check_dead_forces(
+    samples: &mut [Sample],
+    channels: &mut Vec<String>,
+    report: &mut LoadReport,
+) {
+    let fmax = max_abs_fz(samples);
+    type Get = fn(&Sample) -> f64;
+    let checks: [(&str, &str, Get, Get, f64, &str); 2] = [
+        ("Fx", "kappa", |s| s.fx, |s| s.kappa, DEAD_KAPPA, "κ"),
+        (
+            "Fy",
+            "alpha",
+            |s| s.fy,
+            |s| s.alpha,
+            DEAD_ALPHA_DEG.to_radians(),
+            "α",
+        ),
+    ];
+    for (force, slip_ch, f, slip, threshold, symbol) in checks {
+        let has = |c: &str| channels.iter().any(|x| x == c);
+        if !has(force) || !has(slip_ch) {
+            continue;
+        }
+        let rows: Vec<(f64, f64)> = samples
+            .iter()
+            .filter(|s| loaded(s, fmax) && s.fz > 0.0)
+            .map(|s| (slip(s), f(s) / s.fz))
+            .filter(|(x, r)| x.is_finite() && r.is_finite())
+            .collect();
+        let Some(mid) = median(rows.iter().map(|r| r.0)) else {
+            continue;
+        };
+        let side = |sign: f64| -> Vec<f64> {
+            rows.iter()
+                .filter(|(x, _)| sign * (x - mid) >= threshold)
+                .map(|r| r.1)
+                .collect()
+        };
+        let (pos, neg) = (side(1.0), side(-1.0));
+        if pos.len() < DEAD_MIN_ROWS || neg.len() < DEAD_MIN_ROWS {
+            continue;
+        }
+        let (np, nn) = (pos.len(), neg.len());
+        let d = median(pos).unwrap_or(f64::NAN) - median(neg).unwrap_or(f64::NAN);
+        if d.abs() < DEAD_FORCE {
+            let step = if symbol == "κ" {
+                format!("{threshold:.2}")
+            } else {
+                format!("{:.0}°", threshold.to_degrees())
+            };
+            reject(
+                samples,
+                channels,
+                report,
+                force,
+                format!(
+                    "it does not follow the slip: its median {force}/Fz differs by {d:+.4} between the {np} loaded rows at {symbol} ≥ +{step} and the {nn} at {symbol} ≤ −{step} from the median {symbol}, where a tyre gives 0.1 or more even on ice (at most {DEAD_FORCE} counts as dead): a dead or disconnected force channel, or one in a unit far larger than its label (kN read as N?)"
+                ),
+            );
+        }
+    }
 }
 
 /// How far Fx/Fz may stray from the recording's free-rolling level on a

@@ -451,8 +451,13 @@ fn devset_verdicts_hold_at_half_the_sample_rate() {
 /// controls 3/3; before the overshadow rule
 /// (`diagnose::candidate::OVERSHADOW`) r14 (thermal) was named
 /// `load_sensitivity` on a 3.7 % Mz gain where the thermal candidate, which
-/// spoils that recording's Fx, removed 25 %.
+/// spoils that recording's Fx, removed 25 %. On demand since 30 Nov 2026
+/// (it passed unchanged in every run since 28 Nov): a clean clone's CI run
+/// took 63 minutes on that day's machine, over the project's 60-minute aim,
+/// and of the four live variations this one perturbs the recordings least —
+/// the dev set's own `short` programme already holds a shorter test.
 #[test]
+#[ignore = "on demand: every recording cut after 85 % of its rows (15 of 18 named since 28 Nov); off CI since 30 Nov to keep it inside the hour"]
 fn devset_shortened_programmes_name_no_wrong_effect() {
     let Some(v) = variant_verdicts("diagnose_devset_cut", |_, l| {
         keep_rows(l, |i, rows| 100 * i < 85 * rows)

@@ -148,8 +148,15 @@ fn dev_set_radii_lateral_only_with_rolling_resistance() {
 /// radius (+0.14 % at 48 km/h, −0.08 % at 32) and a tied Re 0.07 % off at
 /// the outer loads.
 fn check_re_bias(path: &str) {
+    check_re_bias_thinned(path, 1, true);
+}
+
+/// [`check_re_bias`] with the geometry fitted to every `stride`-th sample
+/// (as `diagnose` thins a long recording for its baseline) and checked on
+/// all of them, grouped by load level and, with `by_speed`, belt speed.
+fn check_re_bias_thinned(path: &str, stride: usize, by_speed: bool) {
     let Some(r) = rec(path) else { return };
-    let (t, _) = geometry_only(&r);
+    let (t, _) = geometry_only(&tyrekit::diagnose::baseline::decimate(&r, stride));
     let tyre = Tyre::new(t).unwrap();
     let sr = r.extra("SR").expect("a recorded SR");
     let re = r.extra("Re").expect("a recorded Re");
@@ -172,7 +179,11 @@ fn check_re_bias(path: &str) {
         );
         let key = (
             (s.fz / (0.05 * fmax)).round() as i64,
-            (3.6 * s.vx / 4.0).round() as i64,
+            if by_speed {
+                (3.6 * s.vx / 4.0).round() as i64
+            } else {
+                0
+            },
         );
         groups.entry(key).or_default().push(o.re / rig - 1.0);
     }
@@ -185,20 +196,23 @@ fn check_re_bias(path: &str) {
         let mean = e.iter().sum::<f64>() / n;
         let sd = (e.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
         let tol = 2e-4 + 3.5 * sd / n.sqrt();
+        let speed = if by_speed {
+            format!("{} km/h", 4 * speed)
+        } else {
+            "all speeds".to_string()
+        };
         println!(
-            "{path}: load {:.0} %, {} km/h: {} samples, Re bias {:+.4} % (tolerance {:.4} %)",
+            "{path}: load {:.0} %, {speed}: {} samples, Re bias {:+.4} % (tolerance {:.4} %)",
             5 * load,
-            4 * speed,
             e.len(),
             100.0 * mean,
             100.0 * tol
         );
         if mean.abs() >= tol {
             off.push(format!(
-                "{:+.4} % at {:.0} % load, {} km/h",
+                "{:+.4} % at {:.0} % load, {speed}",
                 100.0 * mean,
                 5 * load,
-                4 * speed
             ));
         }
         checked += 1;
@@ -217,4 +231,26 @@ fn check_re_bias(path: &str) {
 fn dev_set_radius_is_unbiased_by_load_and_speed() {
     check_re_bias("../shared/data/diagnose-dev/r08.dat.gz");
     check_re_bias("../shared/data/diagnose-dev/r17.dat.gz");
+}
+
+/// Dev-set r07: a rig whose slip ratio was computed with one radius at
+/// every load (197.5 mm; the tyre's own V/Ω falls from 200.3 to 198.0 mm).
+/// Fitted on every sample, or every 3rd or 5th (the stride `diagnose`
+/// thins this recording by is 3), the file's Re follows that constant
+/// radius. Until 1 Dec the thinned fits found no Re(Fz) with non-negative
+/// deflection terms (the flat radius's unconstrained terms came out
+/// negative), took the loaded radius's tie unchecked — Re 2 % above the
+/// rig's at low load — and the diagnosis's baseline.tir replayed the
+/// drive/brake runs' Fx 2.6× worse than the answers' least-squares
+/// baseline (NRMSE 0.0175 against 0.0067). Grouped by load only: the
+/// question is Re(Fz), and r07's groups per belt speed hold ~30 samples
+/// each whose rig radius itself scatters by up to 0.07 % (15 % load: 197.57
+/// mm at 32 km/h, 197.45 and 197.43 mm at 40 and 48), beyond the standard
+/// error those correlated 100 Hz samples suggest; the speed test is r08's
+/// and r17's above.
+#[test]
+fn dev_set_radius_is_fitted_whatever_the_thinning() {
+    for stride in [1, 3, 5] {
+        check_re_bias_thinned("../shared/data/diagnose-dev/r07.dat.gz", stride, false);
+    }
 }

@@ -63,6 +63,17 @@ const GAP_MEDIAN_BEFORE: f64 = 0.33;
 /// the MF fitted again beneath it), with the same margin for another CPU.
 const GAP_MIN_BEFORE: f64 = -0.05;
 
+/// Most that `baseline.tir`, replayed as a user replays it, may stand above
+/// the answer's baseline in any pure-slip channel. Both are the MF 6.1
+/// fitted to the recording — the answer's by plain least squares on the
+/// pure-slip rows of the first 70 %, started from the generating file;
+/// ours from the built-in tyre on every row, pressures pooled, with its own
+/// radii — so ours may lose a little where the effect lives in that channel
+/// (highest 1 Dec 2026: 1.16, r04 Fy, a pressure recording pooled to one
+/// pressure) but not a quarter: dev-set r07's Fx stood at 2.6× from a
+/// rolling radius the thinned geometry fit had got wrong (fixed 1 Dec).
+const BASELINE_OVER_ANSWER_MAX: f64 = 1.25;
+
 struct Outcome {
     name: String,
     effect: String,
@@ -80,6 +91,9 @@ struct Outcome {
     /// (read on the controls: how near the truth a baseline gets where
     /// nothing is missing).
     to_truth: Vec<(String, f64)>,
+    /// Per pure-slip channel: baseline.tir's NRMSE over the answer's
+    /// least-squares baseline ([`BASELINE_OVER_ANSWER_MAX`]).
+    to_answer: Vec<(String, f64)>,
     seconds: f64,
 }
 
@@ -214,11 +228,17 @@ fn run(a: &Answer, dir: &Path, data: &Path) -> Outcome {
                 .map(|x| (c.clone(), x.ours / t))
         })
         .collect();
+    let to_answer = base_figs
+        .iter()
+        .filter(|x| x.group == "pure")
+        .map(|x| (x.channel.clone(), x.ratio()))
+        .collect();
     Outcome {
         name: a.name.clone(),
         effect,
         verdict,
         to_truth,
+        to_answer,
         channel,
         recovered: (nr[0] - nr[1]) / (ab - at),
         nrmse: (nr[0], nr[1]),
@@ -267,7 +287,7 @@ fn summary(v: &[Outcome]) -> (usize, usize, usize, usize, f64) {
 
 fn print_table(v: &[Outcome]) {
     println!(
-        "{:<4} {:<17} {:<17} {:<3} {:>9} {:>9} {:>9} {:>9} {:>8} {:>7} | {:>9} {:>9} {:>8} {:>4}",
+        "{:<4} {:<17} {:<17} {:<3} {:>9} {:>9} {:>9} {:>9} {:>8} {:>7} | {:>9} {:>9} {:>8} {:>4} {:>9}",
         "rec",
         "effect",
         "verdict",
@@ -281,11 +301,17 @@ fn print_table(v: &[Outcome]) {
         "base.slp",
         "ext.slp",
         "gap.slp%",
-        "s"
+        "s",
+        "worst base/ans"
     );
     for o in v {
+        let worst = o
+            .to_answer
+            .iter()
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map_or(String::new(), |(c, r)| format!("{c} {r:.2}"));
         println!(
-            "{:<4} {:<17} {:<17} {:<3} {:>9.5} {:>9.5} {:>9.5} {:>9.5} {:>8.1} {:>7.0} | {:>9.5} {:>9.5} {:>8.1} {:>4.0}{}",
+            "{:<4} {:<17} {:<17} {:<3} {:>9.5} {:>9.5} {:>9.5} {:>9.5} {:>8.1} {:>7.0} | {:>9.5} {:>9.5} {:>8.1} {:>4.0} {:>9}{}",
             o.name,
             o.effect,
             o.verdict,
@@ -300,6 +326,7 @@ fn print_table(v: &[Outcome]) {
             o.slips.1,
             100.0 * o.slips.2,
             o.seconds,
+            worst,
             if o.verdict == o.effect { "  ok" } else { "" }
         );
     }
@@ -331,7 +358,8 @@ fn print_table(v: &[Outcome]) {
 
 /// Live: no regression from the last measured level (17/18 named, 3/3
 /// controls `none`, median gap [`GAP_MEDIAN_BEFORE`], no right name's
-/// gap below [`GAP_MIN_BEFORE`]). A partial run (`TYREKIT_DEVSET_ONLY`) checks only
+/// gap below [`GAP_MIN_BEFORE`], no baseline channel above
+/// [`BASELINE_OVER_ANSWER_MAX`] × the answer's). A partial run (`TYREKIT_DEVSET_ONLY`) checks only
 /// the gap floor and that every control in it stays `none`: the counts cover the
 /// whole set.
 #[test]
@@ -349,6 +377,15 @@ fn devset_diagnosis_does_not_regress() {
             o.channel,
             100.0 * o.recovered
         );
+    }
+    for o in v {
+        for (ch, r) in &o.to_answer {
+            assert!(
+                *r <= BASELINE_OVER_ANSWER_MAX,
+                "{}: baseline.tir replays pure {ch} at {r:.2}× the answer's least-squares baseline (at most {BASELINE_OVER_ANSWER_MAX})",
+                o.name
+            );
+        }
     }
     if ne + nc < 21 {
         eprintln!(

@@ -268,7 +268,8 @@ struct ReFit {
 /// non-negative — Re falls with load — and the other columns free: the
 /// exact solution of that small convex problem by trying each set of
 /// deflection terms held at zero and keeping the best feasible one (the
-/// active set has at most two members). None when no set solves.
+/// active set has at most two members): its residual sum of squares and
+/// coefficients. None when no set solves.
 ///
 /// Why not drop an infeasible grid point: on a rig whose radius does not
 /// change with load the unconstrained coefficients scatter around zero,
@@ -282,7 +283,7 @@ fn nonneg_deflection_lstsq(
     y: &[f64],
     off: usize,
     atan: bool,
-) -> Option<Vec<f64>> {
+) -> Option<(f64, Vec<f64>)> {
     let m = rows.first()?.len();
     let bounded: Vec<usize> = if atan { vec![off, off + 1] } else { vec![off] };
     let mut best: Option<(f64, Vec<f64>)> = None;
@@ -321,7 +322,7 @@ fn nonneg_deflection_lstsq(
             best = Some((sse, c));
         }
     }
-    best.map(|(_, c)| c)
+    best
 }
 
 /// `a_fixed`: Rω at zero load given (the loaded radius's zero-load
@@ -378,7 +379,7 @@ fn fit_re(
                 r
             })
             .collect();
-        let Some(c) = nonneg_deflection_lstsq(&rows, &y, off, atan) else {
+        let Some((sse, c)) = nonneg_deflection_lstsq(&rows, &y, off, atan) else {
             continue;
         };
         let cf = c[off];
@@ -396,11 +397,6 @@ fn fit_re(
         } else {
             0.0
         };
-        let sse: f64 = rows
-            .iter()
-            .zip(&y)
-            .map(|(r, yi)| (r.iter().zip(&c).map(|(x, k)| x * k).sum::<f64>() - yi).powi(2))
-            .sum();
         if best.is_none_or(|bb| sse < bb.sse) {
             best = Some(ReFit {
                 a: a_fixed.map_or(c[0], |a| a - q_vx * centre),

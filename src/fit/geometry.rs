@@ -818,14 +818,16 @@ mod tests {
             "the form holds the rig's radius"
         );
     }
+
     /// A rig whose radius does not change with load (its slip channel
     /// computed with one constant radius, dev-set r07) and whose radius
     /// reads slightly *larger* at the higher loads (0.01 mm, measurement
     /// scatter): unconstrained, both deflection coefficients come out
     /// negative at every BREFF of the grid, which used to leave no open fit
     /// — and the loaded radius's tie, 1.5 % off, was then taken unchecked.
-    /// The fit now holds the infeasible terms at zero: Re stays within
-    /// 0.02 mm of the data at every load, DREFF = FREFF = 0.
+    /// The fit now holds the infeasible terms at zero: an open fit exists,
+    /// its deflection terms are non-negative and Re stays within 0.02 mm
+    /// of the data at every load.
     #[test]
     fn a_radius_flat_in_load_is_fitted_with_no_deflection_terms() {
         let (fz0, v0, r0) = (445.0, 11.11, 0.2025);

@@ -774,6 +774,7 @@ pub fn fit_mf(
                 &ctx,
                 &before,
                 tyre,
+                &outs[0],
                 &pure,
                 &channels,
                 judge_rows,

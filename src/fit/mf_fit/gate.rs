@@ -1,12 +1,14 @@
 //! gate — a later stage must not spoil what an earlier one fitted
 //! (issue #14 item 3): the combined-slip stage's result is compared, on the
 //! judged rows (held out where `--holdout` keeps some), with the tyre before
-//! it and with the result after the pure stages were re-polished under the
-//! new combined weights (scored on every kind of row the stage fits: the
-//! combined ones and both pure kinds, each channel on all of them); the
-//! candidate kept is the best one that does not
-//! raise any pure-slip channel's error (else the best-scoring of all,
-//! the tyre before included).
+//! it, with the result after the pure stages were re-polished under the
+//! new combined weights, and with that result after pure Fy and the
+//! lateral combined weights were polished together ([`joint_fy`]: the
+//! stages alone stop where each group is best given the other) — scored on
+//! every kind of row the stage fits: the combined ones and both pure kinds,
+//! each channel on all of them; the candidate kept is the best one that
+//! does not raise any pure-slip channel's error (else the best-scoring of
+//! all, the tyre before included).
 //!
 //! Must never: pick by the fitted rows' cost when held-out rows exist, keep
 //! a candidate that raises a pure-slip channel's judged error beyond
@@ -14,7 +16,11 @@
 
 use super::{run_stage, StageCtx, StageRun};
 use crate::data::SegmentKind;
-use crate::fit::mf_stages::{conditions_of, Channel, StageKind};
+use crate::fit::mf_stages::{
+    conditions_of, fit_stage, gather, stage_params, Channel, StageData, StageKind, COARSE_SAMPLES,
+    START_ITERATIONS,
+};
+use crate::fit::problem::Param;
 use crate::fit::solve::{FitOutcome, ProgressFn};
 use crate::mf::Model;
 use crate::tir::TyreParams;
@@ -141,14 +147,18 @@ fn choose(j0: &Judged, cands: &[&Judged]) -> Option<usize> {
     }
 }
 
-/// Decide the combined stage: candidates `after` (the stage's result) and
-/// `after` with the `pure` stages re-polished from its values; `before` the
-/// tyre the stage started from. Returns the kept tyre, the outcomes of the
-/// re-polish when it is kept, and a line saying what was kept and why.
+/// Decide the combined stage: candidates `after` (the stage's result,
+/// `combined` its outcome), `after` with the `pure` stages re-polished from
+/// its values, and that with pure Fy and the lateral weights polished
+/// together ([`joint_fy`]); `before` the tyre the stage started from.
+/// Returns the kept tyre, the outcomes of the re-polish (and joint polish)
+/// when it is kept, and a line saying what was kept and why.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn accept_combined(
     ctx: &StageCtx,
     before: &TyreParams,
     after: TyreParams,
+    combined: &FitOutcome,
     pure: &[StageKind],
     channels: &[Channel],
     rows: &[Vec<Range<usize>>],
@@ -166,14 +176,18 @@ pub(crate) fn accept_combined(
             outs.push(o);
         }
     }
+    let joint = joint_fy(ctx, &polished, combined, &outs, progress)?;
     let j0 = judge(ctx, before, rows, channels);
-    let cands = [
+    let mut cands = vec![
         ("combined", judge(ctx, &after, rows, channels)),
         (
             "combined + pure re-polish",
             judge(ctx, &polished, rows, channels),
         ),
     ];
+    if let Some((t, _)) = &joint {
+        cands.push(("combined + joint Fy polish", judge(ctx, t, rows, channels)));
+    }
     let pick = choose(&j0, &cands.iter().map(|c| &c.1).collect::<Vec<_>>());
     let figures = |j: &Judged| {
         let v: Vec<String> = channels
@@ -202,13 +216,130 @@ pub(crate) fn accept_combined(
     };
     Ok(match pick {
         Some(0) => (after, Vec::new(), note(cands[0].0)),
-        Some(_) => (polished, outs, note(cands[1].0)),
+        Some(1) => (polished, outs, note(cands[1].0)),
+        Some(_) => {
+            let (t, o) = joint.expect("the third candidate is the joint polish");
+            outs.extend(o);
+            (t, outs, note(cands[2].0))
+        }
         None => (
             before.clone(),
             Vec::new(),
             note("the tyre before it (its judged score is the least)"),
         ),
     })
+}
+
+/// Lateral combined-slip coefficients (Gyκ and SVyκ, 4.E58–4.E67) that
+/// act on the pure cornering rows through their small κ.
+fn lateral_weight(name: &str) -> bool {
+    ["rby", "rcy", "rey", "rhy", "rvy"]
+        .iter()
+        .any(|p| name.starts_with(p))
+}
+
+/// Whether a parameter moved in `o` (fitted, on a bound or not).
+fn moved(p: &crate::fit::solve::ParamResult) -> bool {
+    use crate::fit::solve::ParamStatus;
+    matches!(p.status, ParamStatus::Fitted | ParamStatus::AtBound)
+}
+
+/// Pure Fy and the lateral combined weights polished together on the
+/// cornering and the combined rows (Fy only), then Mz's free coefficients
+/// polished beneath them when the pure stages fitted Mz — both on a
+/// subsample of at most [`COARSE_SAMPLES`] rows (a candidate: the gate
+/// judges it on every judged row). The stages fit these two groups in
+/// turn, and on the pure cornering rows they are coupled: κ there is not 0
+/// (±0.5 % at 10° of slip angle on the dev set's r04, from the wheel-plane
+/// slip of a belt-referred speed), and with a load-dependent Gyκ shift
+/// (RHY2) the weights bend the pure curve at the highest load; each group
+/// then sits at the minimum given the other — a point of the alternation,
+/// not of the joint cost (r04: pure Fy cost 10 % above the joint minimum,
+/// PKY4 pinned on its bound). `None` when the pure Fy stage did not run.
+fn joint_fy(
+    ctx: &StageCtx,
+    tyre: &TyreParams,
+    combined: &FitOutcome,
+    repolished: &[FitOutcome],
+    mut progress: Option<&mut ProgressFn>,
+) -> crate::Result<Option<(TyreParams, Vec<FitOutcome>)>> {
+    let free_in = |kind: StageKind| -> Vec<&str> {
+        repolished
+            .iter()
+            .filter(|o| o.stage == kind.name())
+            .flat_map(|o| o.params.iter().filter(|p| moved(p)))
+            .map(|p| p.name.as_str())
+            .collect()
+    };
+    let mut names = free_in(StageKind::PureFy);
+    if names.is_empty() {
+        return Ok(None);
+    }
+    names.extend(
+        combined
+            .params
+            .iter()
+            .filter(|p| moved(p) && lateral_weight(&p.name))
+            .map(|p| p.name.as_str()),
+    );
+    let steps = [
+        (
+            "joint Fy",
+            Channel::Fy,
+            names,
+            &[SegmentKind::PureLateral, SegmentKind::Combined][..],
+        ),
+        (
+            "joint Fy: Mz",
+            Channel::Mz,
+            free_in(StageKind::Mz),
+            &[SegmentKind::PureLateral][..],
+        ),
+    ];
+    let mut t = tyre.clone();
+    let mut outs = Vec::new();
+    for (name, ch, names, kinds) in steps {
+        let params: Vec<Param> = [StageKind::PureFy, StageKind::Mz, StageKind::Combined]
+            .iter()
+            .flat_map(|&k| stage_params(k, &t.p, false, false))
+            .filter(|p| names.contains(&p.name.as_str()))
+            .collect();
+        let mut data = StageData {
+            meas: vec![Vec::new()],
+            ..Default::default()
+        };
+        for &k in kinds {
+            data.append(gather(&t.p, ctx.recs, Some(ctx.train), k, &[ch]));
+        }
+        if params.is_empty() || data.conds.len() < ctx.opts.min_samples {
+            continue;
+        }
+        let mut data = data.every(data.conds.len() / COARSE_SAMPLES);
+        data.grid = Some(ctx.grid.clone());
+        // A candidate's budget: the iterations a start gets in the race
+        // (the gate judges where it stands; on the 250 Hz rig recording
+        // of `tyrekit bench fit` it was still crawling after 139 steps).
+        let mut opts = ctx.opts.fit.clone();
+        opts.coarse_first = false;
+        opts.lm.max_iter = opts.lm.max_iter.min(START_ITERATIONS);
+        let out = fit_stage(
+            ctx.form,
+            &t.p,
+            &params,
+            &data,
+            &[ch],
+            ctx.opts.threads,
+            &opts,
+            name,
+            progress.as_deref_mut(),
+            &[],
+        )?;
+        for p in &out.params {
+            t.set(&p.name, p.value)?;
+        }
+        outs.push(out);
+    }
+    Ok(Some((t, outs)))
 }
 
 #[cfg(test)]

@@ -238,7 +238,7 @@ fn lateral_weight(name: &str) -> bool {
         .any(|p| name.starts_with(p))
 }
 
-/// Whether a parameter moved in `o` (fitted, on a bound or not).
+/// Whether the stage fitted `p` (inside its bounds or on one), not held it.
 fn moved(p: &crate::fit::solve::ParamResult) -> bool {
     use crate::fit::solve::ParamStatus;
     matches!(p.status, ParamStatus::Fitted | ParamStatus::AtBound)

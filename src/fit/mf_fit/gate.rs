@@ -177,18 +177,22 @@ pub(crate) fn accept_combined(
         }
     }
     let joint = joint_fy(ctx, &polished, combined, &outs, progress)?;
-    let j0 = judge(ctx, before, rows, channels);
+    // Each candidate: its name, its tyre and the outcomes kept with it.
+    let joint = joint.map(|(t, o)| {
+        let all: Vec<FitOutcome> = outs.iter().cloned().chain(o).collect();
+        ("combined + joint Fy polish", t, all)
+    });
     let mut cands = vec![
-        ("combined", judge(ctx, &after, rows, channels)),
-        (
-            "combined + pure re-polish",
-            judge(ctx, &polished, rows, channels),
-        ),
+        ("combined", after, Vec::new()),
+        ("combined + pure re-polish", polished, outs),
     ];
-    if let Some((t, _)) = &joint {
-        cands.push(("combined + joint Fy polish", judge(ctx, t, rows, channels)));
-    }
-    let pick = choose(&j0, &cands.iter().map(|c| &c.1).collect::<Vec<_>>());
+    cands.extend(joint);
+    let j0 = judge(ctx, before, rows, channels);
+    let judged: Vec<Judged> = cands
+        .iter()
+        .map(|(_, t, _)| judge(ctx, t, rows, channels))
+        .collect();
+    let pick = choose(&j0, &judged.iter().collect::<Vec<_>>());
     let figures = |j: &Judged| {
         let v: Vec<String> = channels
             .iter()
@@ -200,7 +204,8 @@ pub(crate) fn accept_combined(
     };
     let detail: Vec<String> = cands
         .iter()
-        .map(|(n, j)| format!("{n}: {}", figures(j)))
+        .zip(&judged)
+        .map(|((n, _, _), j)| format!("{n}: {}", figures(j)))
         .collect();
     let note = |kept: &str| {
         format!(
@@ -215,12 +220,9 @@ pub(crate) fn accept_combined(
         )
     };
     Ok(match pick {
-        Some(0) => (after, Vec::new(), note(cands[0].0)),
-        Some(1) => (polished, outs, note(cands[1].0)),
-        Some(_) => {
-            let (t, o) = joint.expect("the third candidate is the joint polish");
-            outs.extend(o);
-            (t, outs, note(cands[2].0))
+        Some(i) => {
+            let (name, t, o) = cands.swap_remove(i);
+            (t, o, note(name))
         }
         None => (
             before.clone(),

@@ -264,8 +264,17 @@ pub(crate) fn check_dead_forces(
 ) {
     let fmax = max_abs_fz(samples);
     type Get = fn(&Sample) -> f64;
-    let checks: [(&str, &str, Get, Get, f64, &str); 2] = [
-        ("Fx", "kappa", |s| s.fx, |s| s.kappa, DEAD_KAPPA, "κ"),
+    type Show = fn(f64) -> String;
+    let checks: [(&str, &str, Get, Get, f64, &str, Show); 2] = [
+        (
+            "Fx",
+            "kappa",
+            |s| s.fx,
+            |s| s.kappa,
+            DEAD_KAPPA,
+            "κ",
+            |t| format!("{t:.2}"),
+        ),
         (
             "Fy",
             "alpha",
@@ -273,9 +282,10 @@ pub(crate) fn check_dead_forces(
             |s| s.alpha,
             DEAD_ALPHA_DEG.to_radians(),
             "α",
+            |t| format!("{:.0}°", t.to_degrees()),
         ),
     ];
-    for (force, slip_ch, f, slip, threshold, symbol) in checks {
+    for (force, slip_ch, f, slip, threshold, symbol, show) in checks {
         let has = |c: &str| channels.iter().any(|x| x == c);
         if !has(force) || !has(slip_ch) {
             continue;
@@ -302,11 +312,7 @@ pub(crate) fn check_dead_forces(
         let (np, nn) = (pos.len(), neg.len());
         let d = median(pos).unwrap_or(f64::NAN) - median(neg).unwrap_or(f64::NAN);
         if d.abs() < DEAD_FORCE {
-            let step = if symbol == "κ" {
-                format!("{threshold:.2}")
-            } else {
-                format!("{:.0}°", threshold.to_degrees())
-            };
+            let step = show(threshold);
             reject(
                 samples,
                 channels,

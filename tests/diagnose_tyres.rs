@@ -75,6 +75,21 @@ fn control(tyre: &Tyre, seed: u64, path: &Path) {
         .expect("write .mat");
 }
 
+/// `tyrekit diagnose REC --report DIR` as a user runs it (no `--tir`):
+/// asserts it succeeded; returns its stderr and `diagnosis.json`.
+fn diagnose(rec: &Path, report: &Path) -> (String, serde_json::Value) {
+    let o = Command::new(env!("CARGO_BIN_EXE_tyrekit"))
+        .args(["diagnose", rec.to_str().unwrap(), "--report"])
+        .arg(report)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert!(o.status.success(), "{}: {err}", rec.display());
+    let d = serde_json::from_str(&std::fs::read_to_string(report.join("diagnosis.json")).unwrap())
+        .unwrap();
+    (err, d)
+}
+
 #[test]
 fn the_baseline_fits_controls_of_other_real_tyres_within_the_noise() {
     let tir = common::shared().join("data/tir");
@@ -90,19 +105,7 @@ fn the_baseline_fits_controls_of_other_real_tyres_within_the_noise() {
         let rec = dir.join(format!("control{k}.mat"));
         control(&tyre, 100 + k as u64, &rec);
         let report = dir.join(format!("control{k}"));
-        let o = Command::new(env!("CARGO_BIN_EXE_tyrekit"))
-            .args(["diagnose", rec.to_str().unwrap(), "--report"])
-            .arg(&report)
-            .output()
-            .unwrap();
-        assert!(
-            o.status.success(),
-            "{file}: {}",
-            String::from_utf8_lossy(&o.stderr)
-        );
-        let d: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(report.join("diagnosis.json")).unwrap())
-                .unwrap();
+        let (_, d) = diagnose(&rec, &report);
         let fits: Vec<(String, f64)> = d["baseline_fit"]
             .as_array()
             .expect("baseline_fit")
@@ -166,13 +169,7 @@ fn a_recording_whose_forces_follow_no_slip_names_nothing() {
         &rec,
     );
     let report = dir.join("template");
-    let o = Command::new(env!("CARGO_BIN_EXE_tyrekit"))
-        .args(["diagnose", rec.to_str().unwrap(), "--report"])
-        .arg(&report)
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(o.status.success(), "{err}");
+    let (err, d) = diagnose(&rec, &report);
     for ch in ["Fx", "Fy"] {
         assert!(
             err.contains(&format!(
@@ -181,9 +178,6 @@ fn a_recording_whose_forces_follow_no_slip_names_nothing() {
             "{ch} not rejected: {err}"
         );
     }
-    let d: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(report.join("diagnosis.json")).unwrap())
-            .unwrap();
     assert_eq!(d["verdict"], "none", "{}", d["explanation"]);
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -75,16 +75,17 @@ fn control(tyre: &Tyre, seed: u64, path: &Path) {
         .expect("write .mat");
 }
 
-/// `tyrekit diagnose REC --report DIR` as a user runs it (no `--tir`):
-/// asserts it succeeded; returns its stderr and `diagnosis.json`.
-fn diagnose(rec: &Path, report: &Path) -> (String, serde_json::Value) {
+/// `tyrekit diagnose REC --report DIR` as a user runs it (no `--tir`) on
+/// the control of tyre file `what`: asserts it succeeded; returns its
+/// stderr and `diagnosis.json`.
+fn diagnose(what: &str, rec: &Path, report: &Path) -> (String, serde_json::Value) {
     let o = Command::new(env!("CARGO_BIN_EXE_tyrekit"))
         .args(["diagnose", rec.to_str().unwrap(), "--report"])
         .arg(report)
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&o.stderr).into_owned();
-    assert!(o.status.success(), "{}: {err}", rec.display());
+    assert!(o.status.success(), "{what}: {err}");
     let d = serde_json::from_str(&std::fs::read_to_string(report.join("diagnosis.json")).unwrap())
         .unwrap();
     (err, d)
@@ -105,7 +106,7 @@ fn the_baseline_fits_controls_of_other_real_tyres_within_the_noise() {
         let rec = dir.join(format!("control{k}.mat"));
         control(&tyre, 100 + k as u64, &rec);
         let report = dir.join(format!("control{k}"));
-        let (_, d) = diagnose(&rec, &report);
+        let (_, d) = diagnose(file, &rec, &report);
         let fits: Vec<(String, f64)> = d["baseline_fit"]
             .as_array()
             .expect("baseline_fit")
@@ -169,7 +170,7 @@ fn a_recording_whose_forces_follow_no_slip_names_nothing() {
         &rec,
     );
     let report = dir.join("template");
-    let (err, d) = diagnose(&rec, &report);
+    let (err, d) = diagnose("TIR_template.tir", &rec, &report);
     for ch in ["Fx", "Fy"] {
         assert!(
             err.contains(&format!(

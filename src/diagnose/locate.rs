@@ -31,7 +31,8 @@
 //!   (rising − falling residual at the same slip, 20 slip bins) is reported
 //!   as the hysteresis amplitude;
 //! * `force_rate` — r²(r, −dF_sim/dt): a lag makes the measurement late, so
-//!   the residual follows minus the force rate;
+//!   the residual follows minus the force rate; the slope is the delay
+//!   (seconds, and metres rolled), reported beside it;
 //! * `time_in_run` — r²(u, time since the segment began): drift.
 //!
 //! Null for sample-level statistics: each segment's residual series is
@@ -117,7 +118,9 @@ pub struct Finding {
     /// `x_min`, `x_max` (set points) and `scale_at_min`, `scale_at_max`
     /// (relative force scale errors there); `slip_region` the mean signed
     /// residual per region `linear`, `peak`, `sliding` (channel unit);
-    /// `sweep_direction` the paired `rising_minus_falling` residual.
+    /// `sweep_direction` the paired `rising_minus_falling` residual;
+    /// `force_rate` the delay it amounts to, `delay_s` (s, + = measured
+    /// late) and `delay_m` (m rolled).
     pub groups: Vec<(String, f64)>,
     /// The share of the channel's residual sum of squares (over the
     /// segments analysed) that the grouping's structure accounts for — its
@@ -323,6 +326,11 @@ struct Within {
     u: Vec<f64>,
     dir: Vec<f64>,
     rate: Vec<f64>,
+    /// Minus the model's force rate per second, −ΔF_sim/Δt (0 where Δt is
+    /// unknown), for the delay estimate of [`delay`].
+    rate_per_s: Vec<f64>,
+    /// Wheel-centre speed |Vx| (m/s; NaN without samples).
+    speed: Vec<f64>,
     time: Vec<f64>,
     /// 0 linear, 1 peak, 2 sliding.
     region: Vec<u8>,
@@ -339,6 +347,8 @@ fn within(d: &Residuals) -> Within {
         u: vec![],
         dir: vec![],
         rate: vec![],
+        rate_per_s: vec![],
+        speed: vec![],
         time: vec![],
         region: vec![],
         slip: vec![],
@@ -383,8 +393,17 @@ fn within(d: &Residuals) -> Within {
             w.r.push(d.r[i] - mr);
             w.u.push(d.r[i] * d.sim[i].signum() - mu);
             w.dir.push(f64::from(*d.sweep_dir.get(i).unwrap_or(&0)));
-            let prev = if j > 0 { d.sim[idx[j - 1]] } else { d.sim[i] };
-            w.rate.push(-(d.sim[i] - prev));
+            let p = if j > 0 { idx[j - 1] } else { i };
+            w.rate.push(-(d.sim[i] - d.sim[p]));
+            let dt = d.t_in_segment.get(i).copied().unwrap_or(f64::NAN)
+                - d.t_in_segment.get(p).copied().unwrap_or(f64::NAN);
+            w.rate_per_s.push(if dt > 0.0 {
+                -(d.sim[i] - d.sim[p]) / dt
+            } else {
+                0.0
+            });
+            w.speed
+                .push(d.samples.get(i).map_or(f64::NAN, |x| x.vx.abs()));
             w.time
                 .push(d.t_in_segment.get(i).copied().unwrap_or(f64::NAN));
             let theta = if peak > 0.0 { k * s.abs() / peak } else { 0.0 };
@@ -406,6 +425,23 @@ fn within(d: &Residuals) -> Within {
         }
     }
     w
+}
+
+/// The delay the residual shows, in seconds and in metres rolled: a
+/// measurement late by τ reads F(t − τ) ≈ F(t) − τ·dF/dt, so τ is the
+/// least-squares slope of the residual on minus the model's force rate
+/// (first order in τ; a few tenths of a second against sweeps of seconds).
+/// The distance is τ times the mean wheel-centre speed (NaN without
+/// samples).
+fn delay(w: &Within) -> (f64, f64) {
+    let tau = slope(&w.rate_per_s, &w.r);
+    let v: Vec<f64> = w.speed.iter().copied().filter(|x| x.is_finite()).collect();
+    let speed = if v.is_empty() {
+        f64::NAN
+    } else {
+        v.iter().sum::<f64>() / v.len() as f64
+    };
+    (tau, tau * speed)
 }
 
 /// Between-group share R² of `y` over groups 0..3.
@@ -669,6 +705,10 @@ pub fn locate(d: &Residuals, o: &LocateOptions) -> Vec<Finding> {
                 }
                 "sweep_direction" => f.groups = vec![("rising_minus_falling".into(), hyst)],
                 "time_in_run" => f.groups = vec![("slope_per_s".into(), drift)],
+                "force_rate" => {
+                    let (s, m) = delay(&w);
+                    f.groups = vec![("delay_s".into(), s), ("delay_m".into(), m)];
+                }
                 _ => {}
             }
         }

@@ -535,6 +535,10 @@ pub fn diagnose_with(
             explanation.push_str(&c);
         }
     }
+    if let Some(w) = super::explain::one_channel_lag(&findings) {
+        explanation.push(' ');
+        explanation.push_str(&w);
+    }
     let locate = findings
         .iter()
         .map(|(ch, f)| (ch.key(), f.clone()))

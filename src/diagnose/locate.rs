@@ -329,8 +329,9 @@ struct Within {
     /// Minus the model's force rate per second, −ΔF_sim/Δt (0 where Δt is
     /// unknown), for the delay estimate of [`delay`].
     rate_per_s: Vec<f64>,
-    /// Wheel-centre speed |Vx| (m/s; NaN without samples).
-    speed: Vec<f64>,
+    /// Mean wheel-centre speed |Vx| of the samples taken (m/s; NaN
+    /// without samples).
+    speed: f64,
     time: Vec<f64>,
     /// 0 linear, 1 peak, 2 sliding.
     region: Vec<u8>,
@@ -348,7 +349,7 @@ fn within(d: &Residuals) -> Within {
         dir: vec![],
         rate: vec![],
         rate_per_s: vec![],
-        speed: vec![],
+        speed: f64::NAN,
         time: vec![],
         region: vec![],
         slip: vec![],
@@ -356,6 +357,7 @@ fn within(d: &Residuals) -> Within {
     };
     let total: usize = d.segments.iter().map(|g| g.len()).sum();
     let stride = total.div_ceil(MAX_WITHIN).max(1);
+    let mut speed = (0.0, 0usize);
     for g in d.segments {
         let idx: Vec<usize> = (g.start..g.end.min(d.r.len()))
             .step_by(stride)
@@ -394,16 +396,20 @@ fn within(d: &Residuals) -> Within {
             w.u.push(d.r[i] * d.sim[i].signum() - mu);
             w.dir.push(f64::from(*d.sweep_dir.get(i).unwrap_or(&0)));
             let p = if j > 0 { idx[j - 1] } else { i };
-            w.rate.push(-(d.sim[i] - d.sim[p]));
+            let df = d.sim[i] - d.sim[p];
+            w.rate.push(-df);
             let dt = d.t_in_segment.get(i).copied().unwrap_or(f64::NAN)
                 - d.t_in_segment.get(p).copied().unwrap_or(f64::NAN);
-            w.rate_per_s.push(if dt > 0.0 {
-                -(d.sim[i] - d.sim[p]) / dt
-            } else {
-                0.0
-            });
-            w.speed
-                .push(d.samples.get(i).map_or(f64::NAN, |x| x.vx.abs()));
+            w.rate_per_s.push(if dt > 0.0 { -df / dt } else { 0.0 });
+            if let Some(v) = d
+                .samples
+                .get(i)
+                .map(|x| x.vx.abs())
+                .filter(|v| v.is_finite())
+            {
+                speed.0 += v;
+                speed.1 += 1;
+            }
             w.time
                 .push(d.t_in_segment.get(i).copied().unwrap_or(f64::NAN));
             let theta = if peak > 0.0 { k * s.abs() / peak } else { 0.0 };
@@ -424,6 +430,9 @@ fn within(d: &Residuals) -> Within {
             *t = 0.0;
         }
     }
+    if speed.1 > 0 {
+        w.speed = speed.0 / speed.1 as f64;
+    }
     w
 }
 
@@ -435,13 +444,7 @@ fn within(d: &Residuals) -> Within {
 /// samples).
 fn delay(w: &Within) -> (f64, f64) {
     let tau = slope(&w.rate_per_s, &w.r);
-    let v: Vec<f64> = w.speed.iter().copied().filter(|x| x.is_finite()).collect();
-    let speed = if v.is_empty() {
-        f64::NAN
-    } else {
-        v.iter().sum::<f64>() / v.len() as f64
-    };
-    (tau, tau * speed)
+    (tau, tau * w.speed)
 }
 
 /// Between-group share R² of `y` over groups 0..3.

@@ -4,28 +4,12 @@
 //! to them under constant slip, with the brush's own relaxation length
 //! σα = C_y/C_Fy, and a step allocates nothing.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
+use crate::allocations_on_this_thread;
 use tyrekit::brush::{BrushInput, BrushParams};
 use tyrekit::mf::Tyre;
 use tyrekit::transient::{
     InputMode, TransientConfig, TransientKind, TransientModel, TransientOptions, WheelInput,
 };
-
-// Per-thread count: the other tests of this file allocate concurrently.
-thread_local! { static ALLOCS: Cell<usize> = const { Cell::new(0) }; }
-struct Counting;
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
-        unsafe { System.alloc(l) }
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        unsafe { System.dealloc(p, l) }
-    }
-}
-#[global_allocator]
-static GLOBAL: Counting = Counting;
 
 fn model(kind: TransientKind, b: BrushParams) -> TransientModel {
     TransientModel::with_options(
@@ -139,7 +123,7 @@ fn brush_step_does_not_allocate() {
     .into_iter()
     .map(|k| model(k, b))
     .collect();
-    let before = ALLOCS.with(|c| c.get());
+    let before = allocations_on_this_thread();
     for m in ms.iter_mut() {
         for i in 0..200 {
             let inp = WheelInput {
@@ -153,5 +137,5 @@ fn brush_step_does_not_allocate() {
             let _ = m.step(&tyre, &inp, 1e-3).unwrap();
         }
     }
-    assert_eq!(ALLOCS.with(|c| c.get()), before);
+    assert_eq!(allocations_on_this_thread(), before);
 }

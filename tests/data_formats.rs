@@ -202,7 +202,7 @@ fn malformed_files_name_the_place() {
 }
 
 /// Load speed: a million rows (14 ISO columns) as CSV and as compressed .mat.
-/// Run with `cargo test --release --test data_formats -- --ignored --nocapture`.
+/// Run with `cargo test --release --test suite data_formats:: -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn million_rows_load_time() {

@@ -6,13 +6,10 @@
 //! answer's baseline (plain least squares on the first 70 %, started from the
 //! generating `.tir`). Prints one table row per figure.
 //!
-//! Run: `cargo test --release --test devset_fit -- --nocapture` (21 fits,
+//! Run: `cargo test --release --test suite devset_fit:: -- --nocapture` (21 fits,
 //! two at a time). Skips with a message when `../shared` is absent.
 
-#[path = "common/mod.rs"]
-mod common;
-#[path = "common/devset.rs"]
-mod devset;
+use crate::devset;
 
 use devset::{Answer, Figure};
 use std::path::Path;

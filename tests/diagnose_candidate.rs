@@ -1,6 +1,6 @@
 //! The relaxation candidate: named on a slip-lag truth, not on the control.
 
-mod common;
+use crate::common;
 
 use tyrekit::data::Recording;
 use tyrekit::diagnose::replay::ReplayOptions;

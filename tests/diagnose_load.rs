@@ -5,7 +5,7 @@
 //! pass means it follows the physics, not one formula. The control (the
 //! plain MF) must stay `none`.
 
-mod common;
+use crate::common;
 
 use tyrekit::diagnose::report::diagnose;
 use tyrekit::mf::Tyre;

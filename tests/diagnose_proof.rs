@@ -18,7 +18,7 @@
 //! `TYREKIT_PROOF_FILTER=name` restricts the run to effects whose name
 //! contains it (development aid; the full run is the proof).
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use tyrekit::data::{load, LoadOptions, ReChoice, Recording};

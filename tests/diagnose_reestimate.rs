@@ -13,7 +13,7 @@
 //! again at the recorded pressures instead; the third for a rolling-radius
 //! finding from a slip channel computed with one constant radius.
 
-mod common;
+use crate::common;
 
 use tyrekit::data::{Recording, Sample, SegmentKind};
 use tyrekit::diagnose::baseline::fit_baseline;

@@ -2,7 +2,7 @@
 //! (`candidate::refit_on_all`), not the half fit that was scored: the
 //! selection is made out of sample, the estimate then uses all the data.
 
-mod common;
+use crate::common;
 
 use tyrekit::diagnose::candidate::{all, evaluate, held_out_sse, refit_on_all};
 use tyrekit::diagnose::report::diagnose;

@@ -10,7 +10,7 @@
 //! speed programmes of tyre tests) with white sensor noise, and the same
 //! programme without any effect as the control.
 
-mod common;
+use crate::common;
 
 use tyrekit::data::{Recording, Segment};
 use tyrekit::diagnose::replay::ReplayOptions;

@@ -29,7 +29,7 @@
 //! (that is `diagnose_devset`'s job). Skips with a message without
 //! `../shared`.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::process::Command;

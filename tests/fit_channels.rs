@@ -7,7 +7,7 @@
 //! solution's Fy reuses Fy0 computed once for Mz, which can reorder nothing
 //! that changes the derivative beyond an ulp or two).
 
-mod common;
+use crate::common;
 
 use tyrekit::fit::channels::{eval, eval_given};
 use tyrekit::fit::mf_stages::{conditions_of, Channel};

@@ -13,8 +13,6 @@
 //! stage was skipped and Fy0 stayed the start tyre's; on the dev set cut to
 //! its drive/brake rows that left Fy at 17× the noise floor.
 
-mod common;
-
 use tyrekit::data::{Recording, SegmentKind};
 use tyrekit::fit::mf_fit::{fit_mf, MfFitOptions};
 use tyrekit::fit::mf_stages::USE_MODE;

@@ -13,7 +13,7 @@
 //! use mode and with range limits and α* on (clipped E, sign conventions of
 //! γ*, α* and Vx < 0).
 
-mod common;
+use crate::common;
 
 use rand::{Rng, SeedableRng};
 use tyrekit::fit::grad_pure::{FX_KEYS, FY_KEYS};

@@ -1,7 +1,7 @@
 //! Identifiability (inert and collinear parameters held at their start) and
 //! standard errors against the closed-form linear-regression formulas.
 
-mod fit_support;
+use crate::fit_support;
 use fit_support::*;
 use tyrekit::fit::{fit, FitOptions, Param, ParamStatus, Verdict};
 

@@ -2,7 +2,7 @@
 //! exponential decay, a sine-atan (Magic-Formula-like) curve, bounds, robust
 //! loss, determinism.
 
-mod fit_support;
+use crate::fit_support;
 use fit_support::*;
 use nalgebra::DMatrixViewMut;
 use tyrekit::fit::{fit, lm, FitOptions, LmOptions, Loss, LossKind, Param, ParamStatus, Problem};

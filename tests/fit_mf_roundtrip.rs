@@ -6,7 +6,7 @@
 //! over the data's range, and identifiable parameters near the truth.
 //! Also: the written `.tir` reloads to the same parameters and forces.
 
-mod common;
+use crate::common;
 
 use tyrekit::data::Recording;
 use tyrekit::fit::mf_fit::{fit_mf, MfFitOptions};

@@ -4,7 +4,7 @@
 //! plots drawn; and the written `.tir` reloads to the same parameters and
 //! forces.
 
-mod common;
+use crate::common;
 
 use tyrekit::data::Recording;
 use tyrekit::fit::mf_fit::{fit_mf, overall_sigma, MfFitOptions};

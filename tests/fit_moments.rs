@@ -5,7 +5,7 @@
 //! carry both), fitted from a start whose QSX/QSY come from the built-in
 //! tyre → the fitted moments agree with the truth's over the data's range.
 
-mod common;
+use crate::common;
 
 use tyrekit::data::Recording;
 use tyrekit::fit::mf_fit::{fit_mf, MfFitOptions};

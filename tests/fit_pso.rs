@@ -1,7 +1,7 @@
 //! Particle swarm: global minimum of a multi-modal function, reproducibly;
 //! swarm + LM polish escapes the local minimum that traps LM alone.
 
-mod fit_support;
+use crate::fit_support;
 use fit_support::*;
 use std::f64::consts::PI;
 use tyrekit::fit::{fit, pso, FitOptions, Param, Phase, PsoOptions};

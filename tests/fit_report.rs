@@ -1,6 +1,6 @@
 //! Quality metrics per channel and condition, hold-out splits and the report.
 
-mod fit_support;
+use crate::fit_support;
 use fit_support::*;
 use tyrekit::data::{Recording, Sample, Segment, SegmentKind};
 use tyrekit::fit::metrics::{evaluate, nrmse, sigma};

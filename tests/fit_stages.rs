@@ -1,6 +1,6 @@
 //! Staged fits pass their solution on by name; each stage fits only its own set.
 
-mod fit_support;
+use crate::fit_support;
 use fit_support::*;
 use tyrekit::fit::{run_stages, FitOptions, Param, ParamStatus, ParamValues, Stage};
 

@@ -2,9 +2,7 @@
 //! synthetic data from a different starting tyre: every parameter comes back
 //! within a few standard errors of the truth, and the cost matches the noise.
 
-#[path = "fit_support/standin.rs"]
-#[allow(dead_code)]
-mod standin;
+use crate::standin;
 use standin::{LateralData, LateralStandIn, FZ0, TRUTH};
 use tyrekit::fit::{fit, FitOptions, ParamStatus};
 

@@ -7,7 +7,7 @@
 //!
 //! Skips with a message when `../shared` is absent.
 
-mod common;
+use crate::common;
 
 use tyrekit::data::Recording;
 use tyrekit::fit::metrics;

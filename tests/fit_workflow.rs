@@ -3,9 +3,7 @@
 //! → score fitted and held-out data per condition → report.
 //! (The model is the benchmark's lateral stand-in until the generic MF lands.)
 
-#[path = "fit_support/standin.rs"]
-#[allow(dead_code)]
-mod standin;
+use crate::standin;
 use standin::{lateral_fy, LateralData, FZ0, LOWER, NAMES, START, TRUTH, UPPER};
 use tyrekit::data::{Recording, Sample, Segment, SegmentKind};
 use tyrekit::fit::metrics::evaluate;

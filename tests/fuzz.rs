@@ -16,7 +16,7 @@
 //! synthesises from the Magic Formula and writes with the crate's writers)
 //! plus the shared `.tir` files when present.
 
-mod tir_common;
+use crate::tir_common;
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

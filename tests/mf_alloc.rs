@@ -1,39 +1,13 @@
 //! `Tyre::evaluate`, `evaluate_checked` and `forces` allocate nothing:
-//! counted with a wrapping global allocator (this test binary only).
+//! counted with the allocation binary's global allocator (`tests/alloc.rs`).
 //!
 //! The count is per thread: the test harness's own threads (output capture,
 //! the slow-test watcher) allocate at any time, and CI once saw 4 of their
 //! allocations land inside the measured window. Only the evaluating thread's
 //! allocations say anything about the model.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
+use crate::allocations_on_this_thread;
 use tyrekit::mf::{MfInput, Tyre, UseMode};
-
-struct Counting;
-
-thread_local! {
-    // const-initialised: reading it from inside the allocator never allocates.
-    static ALLOCS: Cell<usize> = const { Cell::new(0) };
-}
-
-fn allocs_on_this_thread() -> usize {
-    ALLOCS.with(|c| c.get())
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        // try_with: the slot may already be gone while a thread shuts down.
-        let _ = ALLOCS.try_with(|c| c.set(c.get() + 1));
-        System.alloc(l)
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        System.dealloc(p, l)
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
 
 #[test]
 fn evaluation_does_not_allocate() {
@@ -63,7 +37,7 @@ fn evaluation_does_not_allocate() {
         .iter()
         .map(|&c| UseMode::from_code(c).unwrap())
         .collect();
-    let before = allocs_on_this_thread();
+    let before = allocations_on_this_thread();
     let mut acc = 0.0;
     for t in &tyres {
         for m in &modes {
@@ -72,7 +46,7 @@ fn evaluation_does_not_allocate() {
             }
         }
     }
-    let after = allocs_on_this_thread();
+    let after = allocations_on_this_thread();
     std::hint::black_box(acc);
     assert_eq!(
         after,

@@ -4,7 +4,7 @@
 //! sweeps (kind 1) are complete in the reference and can be replayed as the
 //! same batches MFeval was called with.
 
-mod common;
+use crate::common;
 use common::{num, reference_input, shared};
 use std::collections::BTreeMap;
 use tyrekit::mf::{MfInput, MfOutput, Tyre, UseMode};

@@ -1,7 +1,7 @@
 //! `tyrekit eval` end to end: the binary fed a reference CSV (its `in_*`
 //! columns) writes MFeval's 30 columns that match the reference.
 
-mod common;
+use crate::common;
 use common::{num, shared};
 use std::process::Command;
 

@@ -3,7 +3,7 @@
 //! report. Expected values are computed here independently from the file's
 //! coefficients (never taken from the code under test).
 
-mod common;
+use crate::common;
 use common::shared;
 use tyrekit::mf::{Clamped, MfInput, Tyre, UseMode};
 use tyrekit::tir::{MfVersion, TyreParams};

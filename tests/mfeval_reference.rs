@@ -17,7 +17,7 @@
 //!
 //! Skips with a message when the shared data is absent.
 
-mod common;
+use crate::common;
 use common::{num, reference_input, shared};
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};

@@ -2,7 +2,7 @@
 //! (or is refused for the stated reason), values agree with an independent
 //! scan of the raw text, and the writer round-trips bit-exactly.
 
-mod tir_common;
+use crate::tir_common;
 
 use tir_common::{file_name, scan_last_number, tir_files};
 use tyrekit::tir::{MfVersion, TyreParams, KEYS};

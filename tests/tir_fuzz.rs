@@ -3,7 +3,7 @@
 //! never panic; whatever it accepts must survive the writer (bit-exact
 //! parameters and the same version on re-read).
 
-mod tir_common;
+use crate::tir_common;
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

@@ -1,30 +1,12 @@
 //! `TransientModel::step` allocates nothing (every model, both input modes,
-//! including standstill, sliding and the non-linear sub-stepping). A counting
-//! global allocator observes the steps; this file holds a single test so no
-//! other test allocates concurrently.
+//! including standstill, sliding and the non-linear sub-stepping), counted on
+//! the stepping thread by the allocation binary's allocator (`tests/alloc.rs`).
 
 mod common;
+use crate::allocations_on_this_thread;
 use common::*;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
 use tyrekit::mf::Tyre;
 use tyrekit::transient::{InputMode, TransientOptions};
-
-struct Counting;
-static ALLOCS: AtomicUsize = AtomicUsize::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        ALLOCS.fetch_add(1, Ordering::SeqCst);
-        unsafe { System.alloc(l) }
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        unsafe { System.dealloc(p, l) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
 
 #[test]
 fn step_does_not_allocate() {
@@ -56,7 +38,7 @@ fn step_does_not_allocate() {
             i
         })
         .collect();
-    let before = ALLOCS.load(Ordering::SeqCst);
+    let before = allocations_on_this_thread();
     let mut sum = 0.0;
     for m in models.iter_mut() {
         for (k, i) in inputs.iter().enumerate() {
@@ -66,7 +48,7 @@ fn step_does_not_allocate() {
             }
         }
     }
-    let after = ALLOCS.load(Ordering::SeqCst);
+    let after = allocations_on_this_thread();
     assert!(sum.is_finite());
     assert_eq!(after - before, 0, "step allocated {} times", after - before);
 }

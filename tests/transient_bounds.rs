@@ -2,7 +2,7 @@
 //! slip history, turn slip is defined at standstill in steady mode, and one
 //! absurd-but-accepted step does not poison the relaxation state.
 
-mod common;
+use crate::common;
 
 use common::{vel, FZ};
 use tyrekit::mf::{Tyre, UseMode};

@@ -4,7 +4,7 @@
 //! temperature is a state slot that heats with frictional power and is
 //! cleared by reset, and the parameters survive the .tir writer.
 
-mod common;
+use crate::common;
 
 use common::{model, slips, FZ};
 use tyrekit::mf::{MfInput, Tyre, UseMode};

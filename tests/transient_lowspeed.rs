@@ -6,7 +6,7 @@
 //! (the tyre sees the mass's velocity held over each step; semi-implicit Euler
 //! for the mass), at 1 ms and 10 ms communication steps.
 
-mod common;
+use crate::common;
 use common::*;
 use tyrekit::mf::Tyre;
 use tyrekit::transient::{InputMode, TransientKind, TransientModel};

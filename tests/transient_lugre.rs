@@ -2,7 +2,7 @@
 //! hysteresis under oscillating slip, the Stribeck curve, braking to a stop and
 //! driving off, and the [LUGRE] section.
 
-mod common;
+use crate::common;
 use common::*;
 use tyrekit::mf::Tyre;
 use tyrekit::transient::{InputMode, LuGreFriction, LuGreParams, TransientKind, TransientOptions};

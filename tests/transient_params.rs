@@ -3,7 +3,7 @@
 //! PTX/PTY relaxation lengths; turn-slip lag; every shared real `.tir` steps
 //! without panicking or producing non-finite output.
 
-mod common;
+use crate::common;
 use common::*;
 use tyrekit::mf::{Tyre, UseMode};
 use tyrekit::tir::{MfVersion, TyreParams};

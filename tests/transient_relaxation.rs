@@ -3,7 +3,7 @@
 //! Expectations come from the MF of the same tyre (steady forces, its slip and
 //! carcass stiffnesses) and from the analytic first-order dynamics.
 
-mod common;
+use crate::common;
 use common::*;
 use tyrekit::mf::Tyre;
 use tyrekit::transient::{InputMode, TransientKind, TransientOptions, WheelInput};

@@ -5,7 +5,7 @@
 //! MFeval evaluates them at negative Vx) are the reference, so that switching
 //! `transient` from steady to relaxation never flips a sign in reverse.
 
-mod common;
+use crate::common;
 use common::*;
 use tyrekit::mf::Tyre;
 use tyrekit::transient::{TransientKind, WheelInput};

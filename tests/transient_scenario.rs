@@ -1,7 +1,7 @@
 //! Quarter-vehicle braking from 100 km/h: locked wheel and slip control
 //! (~15 %), stopping distance against S = v0·τ/2 + v0²/(2·a_max).
 
-mod common;
+use crate::common;
 use tyrekit::mf::Tyre;
 use tyrekit::transient::scenario::{BrakeControl, BrakingScenario};
 use tyrekit::transient::TransientKind;

@@ -3,7 +3,7 @@
 //! reason, doubtful ones load with a warning — through the library
 //! (`Tyre::from_file`, what the CLI and the FMU call) and the `eval` command.
 
-mod tir_common;
+use crate::tir_common;
 
 use std::path::PathBuf;
 use tir_common::{file_name, tir_files};

@@ -285,7 +285,7 @@ pub fn run_all<T: Send>(
 ) -> Option<Vec<T>> {
     use std::sync::atomic::{AtomicUsize, Ordering};
     use std::sync::Mutex;
-    let dir = crate::common::shared().join("data/diagnose-dev");
+    let dir = super::common::shared().join("data/diagnose-dev");
     let Some(mut answers) = answers(&dir) else {
         eprintln!(
             "SKIP {test}: {} not found (the shared dev set)",

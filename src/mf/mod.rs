@@ -489,6 +489,20 @@ impl Tyre {
         }
     }
 
+    /// The overturning moment Mx at the load, inclination and pressure of
+    /// `inp` (its slips are not read) with the lateral force `fy` given:
+    /// the equation [`Tyre::forces`] uses (Pacejka, *Tyre and Vehicle
+    /// Dynamics*, 3rd ed., eq. 4.E69, with the MF 6.1 paper's camber and
+    /// load terms), bit-identical to its `mx` for that evaluation's `fy`.
+    /// The transient models' similarity method needs it on a road of
+    /// another friction, where Fy scales and Mx's inclination and load
+    /// terms do not ([`crate::transient::mf_at`]).
+    #[inline]
+    pub fn overturning_moment(&self, inp: &MfInput, mode: UseMode, fy: f64) -> f64 {
+        let (c, _) = self.conditions(inp, mode);
+        self.model.mx_with_fy(&c, fy)
+    }
+
     /// Fx and Fy of [`Tyre::forces_mu`] only (bit-identical to its `fx`,
     /// `fy`), without the moment equations ([`Model::solve_fxfy`]); `pre`
     /// as in [`Tyre::forces_with`]. Allocation-free.

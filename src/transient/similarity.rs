@@ -15,13 +15,24 @@ use crate::mf::{Forces, LoadTerms, MfInput, SlipProps, Tyre, UseMode};
 /// Radt & Pacejka): a friction change by `s` that leaves the slip stiffness
 /// unchanged maps the pure-slip curve as F_s(κ) = s·F(κ/s), exactly for
 /// D = μFz with B·C·D fixed (what LMUX/LMUY do to the MF core), approximately
-/// for the shifts, the combined-slip weights and the moments (Mx, Mz scaled
-/// by s; My unscaled). No extra evaluation and no parameter copy.
+/// for the shifts, the combined-slip weights and Mz (scaled by s: the trail
+/// times the scaled Fy, the residual torque's D ∝ μy). Mx is the MF's own
+/// overturning moment at the scaled Fy ([`Tyre::overturning_moment`], one
+/// more Mx evaluation when s ≠ 1): its inclination and load terms do not
+/// depend on the road's friction, and scaling them by s had given
+/// |Mx| > 10·Fz·R0 at 86° inclination with μ ×4.3 (the FMU fuzzer,
+/// 1 Dec 2026). My is unscaled. No parameter copy.
 /// A native `mu_scale` in `MfInput` (scaling LMUX/LMUY inside the MF) would
 /// make this exact — see the transient report.
 #[inline]
 pub fn mf_at(tyre: &Tyre, base: &MfInput, mode: UseMode, slip: Slip, s: f64) -> Forces {
-    similar_forces(tyre.forces(&similar_input(base, slip, s), mode), s)
+    similar_forces(
+        tyre,
+        base,
+        mode,
+        tyre.forces(&similar_input(base, slip, s), mode),
+        s,
+    )
 }
 
 /// [`mf_at`] without My (NaN; [`Tyre::forces_with`]) and with the step's
@@ -37,7 +48,7 @@ pub(crate) fn mf_at_no_my(
     pre: Option<&LoadTerms<f64>>,
 ) -> Forces {
     let f = tyre.forces_with(&similar_input(base, slip, s), mode, 1.0, false, pre);
-    similar_forces(f, s)
+    similar_forces(tyre, base, mode, f, s)
 }
 
 /// [`mf_at`] plus the slip-independent properties of the same evaluation
@@ -51,17 +62,18 @@ pub(crate) fn mf_at_props(
     s: f64,
 ) -> (Forces, SlipProps) {
     let (f, p) = tyre.forces_and_props(&similar_input(base, slip, s), mode, 1.0);
-    (similar_forces(f, s), p)
+    (similar_forces(tyre, base, mode, f, s), p)
 }
 
-/// The similarity method's force scaling of [`mf_at`] (Fx, Fy, Mx, Mz × s).
+/// The similarity method's scaling of [`mf_at`]: Fx, Fy, Mz × s, Mx the
+/// MF's at the scaled Fy (the inclination, load and pressure of `base`).
 #[inline]
-fn similar_forces(mut o: Forces, s: f64) -> Forces {
+fn similar_forces(tyre: &Tyre, base: &MfInput, mode: UseMode, mut o: Forces, s: f64) -> Forces {
     if s != 1.0 {
         o.fx *= s;
         o.fy *= s;
-        o.mx *= s;
         o.mz *= s;
+        o.mx = tyre.overturning_moment(base, mode, o.fy);
     }
     o
 }

@@ -262,6 +262,66 @@ fn a_force_channel_that_does_not_follow_its_slip_is_rejected() {
     }
 }
 
+/// An aligning-moment channel that does not follow the lateral force is a
+/// dead moment cell (or one a thousand times too small: kN·m under an
+/// `N-m` label) and is rejected by name, rows and forces kept: an MZ that
+/// reads a 2 N m zero and ±1 N m of noise through the cornering sweeps,
+/// and the same programme's MZ divided by 1000. Fitted, either would give
+/// a tyre with zero pneumatic trail. The healthy recording's MZ implies a
+/// trail well above the 1 mm bound (checked here too), and the ice
+/// recording below keeps its Mz as well.
+#[test]
+fn a_moment_channel_that_does_not_follow_the_lateral_force_is_rejected() {
+    let run = full_run(&Tyre::builtin(), 13);
+    let mut dead = run.clone();
+    for (i, x) in col(&mut dead, "MZ").iter_mut().enumerate() {
+        *x = 2.0 + (((i * 7919) % 201) as f64 / 100.0 - 1.0);
+    }
+    let mut knm = run.clone();
+    col(&mut knm, "MZ").iter_mut().for_each(|x| *x /= 1000.0);
+    for (r, what) in [(dead, "dead"), (knm, "kN m")] {
+        let p = tmp(&format!("dead_mz_{}.dat", what.replace(' ', "_")));
+        r.write_dat(&p).unwrap();
+        let l = read(&p);
+        assert!(
+            rejected(&l, "Mz"),
+            "{what}: Mz kept: {:?}",
+            l.report.rejected
+        );
+        let why = l.report.rejected.join(" ");
+        assert!(why.contains("does not follow the lateral force"), "{why}");
+        assert!(!l.recording.has("Mz"), "{what}: Mz still listed");
+        assert!(
+            l.recording.has("Fx") && l.recording.has("Fy") && !rejected(&l, "Fy"),
+            "{what}: a force lost: {why}"
+        );
+        assert_eq!(l.report.dropped_total, 0, "{:?}", l.report.dropped);
+    }
+    let p = tmp("live_mz.dat");
+    run.write_dat(&p).unwrap();
+    let l = read(&p);
+    assert!(l.report.rejected.is_empty(), "{:?}", l.report.rejected);
+    // The healthy Mz: its trail between α = ±(1…3)° is centimetres.
+    let band = |lo: f64, hi: f64| -> (Vec<f64>, Vec<f64>) {
+        l.recording
+            .samples
+            .iter()
+            .filter(|s| s.fz > 1000.0 && (lo..=hi).contains(&s.alpha.to_degrees()))
+            .map(|s| (s.fy / s.fz, s.mz / s.fz))
+            .unzip()
+    };
+    let med = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let ((py, pz), (ny, nz)) = (band(1.0, 3.0), band(-3.0, -1.0));
+    let trail = ((med(pz) - med(nz)) / (med(py) - med(ny))).abs();
+    assert!(
+        trail > 10.0 * tyrekit::data::sanity::DEAD_TRAIL,
+        "healthy trail {trail} m"
+    );
+}
+
 /// The control: a tyre on ice — the built-in tyre's peak friction scaled
 /// to 6 % (LMUX = LMUY = 0.06: |F| ≤ 0.06–0.08 Fz) — keeps both force
 /// channels, as does the same programme at normal friction. The rule's

@@ -789,6 +789,8 @@ pub fn from_raw(raw: RawTable, format: Format, file: &str, opts: &LoadOptions) -
     }
     // A force channel that does not follow its slip is dead (needs κ).
     sanity::check_dead_forces(&mut samples, &mut channels, &mut report);
+    // An aligning moment that does not follow Fy is dead (needs live Fy).
+    sanity::check_dead_moment(&mut samples, &mut channels, &mut report);
     let sample_ch_order = SAMPLE_CHANNELS;
     channels.sort_by_key(|c| sample_ch_order.iter().position(|x| x == c).unwrap_or(99));
     for c in SAMPLE_CHANNELS {

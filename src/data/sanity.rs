@@ -5,8 +5,9 @@
 //! - **A broken channel** (a dead or absurd wheel speed, an effective radius
 //!   outside a physical range of the loaded radius, a slip ratio pinned at −1
 //!   while the tyre carries lateral force, a force channel that does not
-//!   follow its slip (a dead load cell), a moment channel mostly out of
-//!   range or saturated) is *rejected*: its values become NaN, it leaves the
+//!   follow its slip (a dead load cell), an aligning moment that does not
+//!   follow the lateral force, a moment channel mostly out of range or
+//!   saturated) is *rejected*: its values become NaN, it leaves the
 //!   recording's channel list, and a warning naming it goes into
 //!   [`LoadReport::rejected`]. The rows stay.
 //! - **A convention slip** (SAE signs read as ISO-W, a slip angle in degrees
@@ -323,6 +324,91 @@ pub(crate) fn check_dead_forces(
                 ),
             );
         }
+    }
+}
+
+/// Smallest ratio (m) of the aligning moment's change to the lateral
+/// force's change across the straight-running slip angles that a live Mz
+/// channel shows (`check_dead_moment`): the pneumatic trail, |ΔMz| / |ΔFy|
+/// between the rows at α 1–3° either side of the median α. A rolling tyre's
+/// trail at small slip is a sixth to a third of its contact length — about
+/// 1 cm on a kart tyre, 2–4 cm on FSAE and car tyres, more on trucks
+/// (Pacejka, *Tyre and Vehicle Dynamics*, 3rd ed., §1.2.2, §4.3.2) —, and it
+/// does not scale with friction (on ice both changes shrink together); 1 mm
+/// leaves a factor ten below the smallest, while a dead, disconnected or
+/// constant moment channel — or one a thousand times too small (kN·m read
+/// as N·m) — changes by noise only.
+pub const DEAD_TRAIL: f64 = 1e-3;
+
+/// The band of slip angle (degrees from the recording's median α) whose
+/// rows [`check_dead_moment`] compares: inside the linear range of every
+/// tyre (the trail has not yet collapsed towards the force's peak), wide
+/// enough that a cornering sweep crosses it for a second or more.
+const DEAD_MZ_ALPHA_DEG: (f64, f64) = (1.0, 3.0);
+
+/// An aligning-moment channel that does not follow the lateral force: on
+/// the loaded rows at α 1–3° either side of the median α ([`DEAD_MZ_ALPHA_DEG`],
+/// at least [`DEAD_MIN_ROWS`] each side), the medians of Mz/Fz and Fy/Fz
+/// are compared; where Fy changes by at least [`DEAD_FORCE`] and Mz by less
+/// than [`DEAD_TRAIL`] times Fy's change, Mz is rejected with the figures.
+/// Fitted, a dead channel gives a tyre without aligning moment (a zero
+/// trail) and reads as a successful fit. A recording whose slip angle never
+/// crosses the band both ways, or whose Fy is missing or itself dead,
+/// leaves Mz unjudged. Runs after [`check_dead_forces`].
+pub(crate) fn check_dead_moment(
+    samples: &mut [Sample],
+    channels: &mut Vec<String>,
+    report: &mut LoadReport,
+) {
+    let has = |c: &str| channels.iter().any(|x| x == c);
+    if !has("Mz") || !has("Fy") || !has("alpha") {
+        return;
+    }
+    let fmax = max_abs_fz(samples);
+    let rows: Vec<(f64, f64, f64)> = samples
+        .iter()
+        .filter(|s| loaded(s, fmax) && s.fz > 0.0)
+        .map(|s| (s.alpha, s.fy / s.fz, s.mz / s.fz))
+        .filter(|(a, y, z)| a.is_finite() && y.is_finite() && z.is_finite())
+        .collect();
+    let Some(mid) = median(rows.iter().map(|r| r.0)) else {
+        return;
+    };
+    let (lo, hi) = (
+        DEAD_MZ_ALPHA_DEG.0.to_radians(),
+        DEAD_MZ_ALPHA_DEG.1.to_radians(),
+    );
+    let side = |sign: f64| -> (Vec<f64>, Vec<f64>) {
+        rows.iter()
+            .filter(|(a, _, _)| (lo..=hi).contains(&(sign * (a - mid))))
+            .map(|&(_, y, z)| (y, z))
+            .unzip()
+    };
+    let ((py, pz), (ny, nz)) = (side(1.0), side(-1.0));
+    if pz.len() < DEAD_MIN_ROWS || nz.len() < DEAD_MIN_ROWS {
+        return;
+    }
+    let (np, nn) = (pz.len(), nz.len());
+    let d =
+        |a: Vec<f64>, b: Vec<f64>| median(a).unwrap_or(f64::NAN) - median(b).unwrap_or(f64::NAN);
+    let (dy, dz) = (d(py, ny), d(pz, nz));
+    if dy.abs() < DEAD_FORCE || !dy.is_finite() {
+        return;
+    }
+    let trail = (dz / dy).abs();
+    if trail < DEAD_TRAIL {
+        reject(
+            samples,
+            channels,
+            report,
+            "Mz",
+            format!(
+                "it does not follow the lateral force: between the {np} loaded rows at α 1–3° above the median α and the {nn} below it, the median Fy/Fz changes by {dy:+.3} while Mz/Fz changes by {:+.5} m — a pneumatic trail of {:.2} mm, where a rolling tyre has 10 mm or more (at most {:.0} mm counts as dead): a dead or disconnected moment channel, or one in a unit far larger than its label (kN·m read as N·m?)",
+                dz,
+                1e3 * trail,
+                1e3 * DEAD_TRAIL
+            ),
+        );
     }
 }
 

@@ -562,6 +562,64 @@ fn devset_without_wheel_speed_is_diagnosed_on_what_rolls_freely() {
 /// Effects named first without wheel speed (30 Nov 2026).
 const NO_WHEEL_SPEED_NAMED_BEFORE: usize = 7;
 
+/// A data logger's drop-outs: every 20th row missing (a single missing row
+/// is a longer time step, not a gap) and three bursts of 30 rows (0.3 s)
+/// at a quarter, half and three quarters of the recording — three gaps at
+/// which the replay restarts (`diagnose::replay`). The rows' times stay
+/// as recorded.
+fn drop_outs(_: &str, lines: Vec<String>) -> Vec<String> {
+    let rows = lines.len().saturating_sub(2);
+    let bursts = [rows / 4, rows / 2, 3 * rows / 4];
+    keep_rows(lines, |i, _| {
+        i % 20 != 7 && !bursts.iter().any(|&b| (b..b + 30).contains(&i))
+    })
+}
+
+/// The recordings whose evidence is a history across the whole run (the
+/// tread temperature) and a control: the drop-out variation CI runs.
+const HISTORY: [&str; 4] = ["r08", "r14", "r16", "r21"];
+
+/// A history survives logger drop-outs: the thermal recordings and a
+/// control with [`drop_outs`], diagnosed as a user would. Each effect is
+/// named as on the recording itself and the control stays `none`. Found 1
+/// Dec 2026: every gap reset the replay's tread temperature to ambient, and
+/// r16 with drop-outs got `none` (its thermal candidate gained 0.3 % of
+/// the held-out error instead of 12 %); the temperature now carries over a
+/// gap, cooled by its own time constant
+/// (`transient::TransientModel::reset_after_gap`). Relaxation and LuGre
+/// states restart at a gap, as before. All 21 recordings: the on-demand
+/// test below.
+#[test]
+fn devset_history_verdicts_survive_logger_drop_outs() {
+    let Some(v) = variant_verdicts("diagnose_devset_drop_outs", |name, lines| {
+        if HISTORY.contains(&name) {
+            drop_outs(name, lines)
+        } else {
+            lines.into_iter().take(2).collect()
+        }
+    }) else {
+        return;
+    };
+    for (name, effect, verdict) in &v {
+        println!("drop-outs {name}  {effect:<18} {verdict}");
+    }
+    assert_eq!(v.len(), HISTORY.len(), "{v:?}");
+    let wrong: Vec<_> = v.iter().filter(|(_, e, x)| e != x).collect();
+    assert!(wrong.is_empty(), "with logger drop-outs: {wrong:?}");
+}
+
+/// [`drop_outs`] on all 21 recordings: no wrong name, as many named as on
+/// the recordings themselves. Measured 1 Dec 2026 (with the temperature
+/// carried over the gaps): all 21 verdicts as on the recordings, 621 s.
+#[test]
+#[ignore = "on demand (621 s on 1 Dec): the drop-out variation over all 21 recordings; CI runs its four history recordings"]
+fn devset_verdicts_hold_across_logger_drop_outs() {
+    let Some(v) = variant_verdicts("diagnose_devset_drop_outs_all", drop_outs) else {
+        return;
+    };
+    no_wrong_name(&v, "with drop-outs", NAMED_BEFORE);
+}
+
 /// The lines without the columns N, RE, SR and SL.
 fn without_wheel_speed(_: &str, lines: Vec<String>) -> Vec<String> {
     let drop: Vec<bool> = lines[0]

@@ -126,6 +126,93 @@ fn relaxation_replay_beats_steady_on_lagged_truth() {
     );
 }
 
+/// A logger drop-out does not cool the tyre: a `[THERMAL]` tyre (C/h =
+/// 300 s, friction −0.2 per 50 K) slides at α = 6° for 60 s, then the
+/// recording goes on after a gap. The replay restarts its slip states at
+/// the gap but carries the tread temperature, cooled over the gap without
+/// frictional power: ΔT·exp(−gap·h/C) — for a 0.3 s drop-out 0.1 % cooler
+/// than without the gap, for 600 s e^−2 of it; when the time runs
+/// backwards (concatenated files) the second part starts at ambient. The
+/// temperature is read back from each step's friction scale
+/// (s = 1 − 0.2·ΔT/50 K, at the step's start), settling time 0 so that the
+/// restart adds no heat. Before 1 Dec 2026 every gap reset the tyre to
+/// ambient, and a dev recording with three 0.3 s drop-outs lost its thermal
+/// verdict (its candidate gained 0.3 % instead of 12 %).
+#[test]
+fn the_tread_temperature_carries_over_a_gap_and_cools() {
+    let mut p = tyrekit::tir::TyreParams::builtin();
+    let th = p.extra_section(tyrekit::transient::extension::THERMAL_SECTION);
+    for (k, v) in [
+        ("CAPACITY", 12_000.0),
+        ("COOLING", 40.0),
+        ("SHARE", 0.5),
+        ("MU_T1", -0.2),
+    ] {
+        th.set(k, v);
+    }
+    let tyre = Tyre::new(p).unwrap();
+    let tau: f64 = 12_000.0 / 40.0;
+    let n = 12_000;
+    let at = |shift: f64| -> Vec<tyrekit::data::Sample> {
+        (0..n)
+            .map(|i| {
+                let t = 0.01 * i as f64;
+                tyrekit::data::Sample {
+                    time: if i >= n / 2 { t + shift } else { t },
+                    vx: 15.0,
+                    omega: f64::NAN,
+                    fz: 4000.0,
+                    kappa: 0.0,
+                    alpha: 6f64.to_radians(),
+                    gamma: 0.0,
+                    phit: 0.0,
+                    p: f64::NAN,
+                    fx: f64::NAN,
+                    fy: f64::NAN,
+                    mx: f64::NAN,
+                    my: f64::NAN,
+                    mz: f64::NAN,
+                }
+            })
+            .collect()
+    };
+    let opts = ReplayOptions {
+        use_mode: RIG_MODE,
+        settle_time: 0.0,
+        ..Default::default()
+    };
+    // ΔT (K) at the start of the first step after the gap, and the runs.
+    let after_gap = |shift: f64| {
+        let rec = Recording {
+            source: "thermal slide".into(),
+            samples: at(shift),
+            ..Default::default()
+        };
+        let r = replay(&rec, &tyre, &opts).unwrap();
+        let s = r.out[n / 2].friction_scale;
+        ((1.0 - s) * 250.0, r.runs.len())
+    };
+    let (warm, runs) = after_gap(0.0);
+    assert_eq!(runs, 1);
+    assert!(
+        warm > 10.0,
+        "the slide barely heats the tread: ΔT = {warm} K"
+    );
+    // The time without inputs is the shift plus the sample spacing.
+    for (shift, expect, what) in [
+        (0.3, warm * (-0.31 / tau).exp(), "a 0.3 s drop-out"),
+        (600.0, warm * (-600.01 / tau).exp(), "a 600 s pause"),
+        (-60.0, 0.0, "time running backwards"),
+    ] {
+        let (got, runs) = after_gap(shift);
+        assert_eq!(runs, 2, "{what}: the gap must restart the replay");
+        assert!(
+            (got - expect).abs() <= 1e-6 * warm,
+            "{what}: ΔT after the gap {got} K, expected {expect} K (before it {warm} K)"
+        );
+    }
+}
+
 #[test]
 fn csv_has_the_issue_columns() {
     let tyre = Tyre::builtin();

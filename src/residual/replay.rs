@@ -12,7 +12,13 @@
 //!   [`ReplayOptions::gap_factor`] times the median sample spacing (the
 //!   warm-up cut, concatenated files, dropped rows). A continuous recording
 //!   is *not* reset at segment starts: the rig runs through its transitions
-//!   without stopping, so the tyre's state carries over physically.
+//!   without stopping, so the tyre's state carries over physically. At a
+//!   gap of positive duration the tread temperature of a `[THERMAL]` tyre
+//!   carries over, cooled over the gap
+//!   ([`TransientModel::reset_after_gap`]): a logger drop-out of a fraction
+//!   of a second does not cool a tyre whose time constant is minutes, and
+//!   a reset to ambient at each one would make a thermal model fail on any
+//!   recording with drop-outs.
 //! * After a reset, the state is **settled** on the first sample of the run:
 //!   one step of [`ReplayOptions::settle_time`] with that sample's inputs
 //!   held (the transient models integrate exactly, so this is the steady
@@ -35,7 +41,7 @@
 //! (1 + SR)·Re(Fz)/R_SR − 1: SR where the file's radius is the rig's.
 //!
 //! Must never: allocate per sample beyond the output vectors, or carry a
-//! state across a gap.
+//! slip, turn-slip or bristle state across a gap.
 
 use super::input::wheel_input;
 use crate::data::Recording;
@@ -145,6 +151,8 @@ pub fn replay(rec: &Recording, tyre: &Tyre, opts: &ReplayOptions) -> Result<Repl
         .extra(crate::data::slip::SLIP_RADIUS_CHANNEL)
         .filter(|r| r.len() == n);
     let mut run_start: Option<usize> = None;
+    // Time the model's state stands at (a restart cools from there).
+    let mut state_time: Option<f64> = None;
     for (i, s) in rec.samples.iter().enumerate() {
         let dt = if i > 0 { t[i] - t[i - 1] } else { f64::NAN };
         let gap = !(dt.is_finite() && dt > 0.0 && dt <= max_dt);
@@ -155,7 +163,12 @@ pub fn replay(rec: &Recording, tyre: &Tyre, opts: &ReplayOptions) -> Result<Repl
         }
         let o = wheel_input(tyre, s, slip_radius.map(|r| r[i])).and_then(|inp| {
             if run_start.is_none() {
-                model.reset();
+                match state_time {
+                    Some(t0) => model.reset_after_gap(tyre, t[i] - t0),
+                    None => model.reset(),
+                }
+                // The state now stands at this sample's time, taken or not.
+                state_time = Some(t[i]);
                 let settle = opts.settle_time.max(0.0);
                 model.step(tyre, &inp, settle).ok()
             } else {
@@ -167,6 +180,7 @@ pub fn replay(rec: &Recording, tyre: &Tyre, opts: &ReplayOptions) -> Result<Repl
                 if run_start.is_none() {
                     run_start = Some(i);
                 }
+                state_time = Some(t[i]);
                 r.sim.push(Forces {
                     fx: o.fx,
                     fy: o.fy,

@@ -461,6 +461,25 @@ impl TransientModel {
         self.state = TransientState::default();
     }
 
+    /// Restart after `gap` seconds without inputs (a replay's dropped rows
+    /// or refused samples): the slip, turn-slip and bristle states restart
+    /// at rest as in [`TransientModel::reset`] — their history fades within
+    /// a relaxation length, and nothing recorded says what the slips did
+    /// during the gap —, while the
+    /// tread temperature of a `[THERMAL]` extension (slot 3), whose time
+    /// constant is minutes, carries over, cooled over the gap without
+    /// frictional power: ΔT·exp(−gap·h/C), the heat balance of
+    /// [`extension`] with P = 0. A gap that is not a finite positive time
+    /// (time running backwards: concatenated files) resets everything.
+    pub fn reset_after_gap(&mut self, tyre: &Tyre, gap: f64) {
+        let warm = self.state.x[extension::SLOT_TEMP];
+        self.reset();
+        let thermal = tyre.extension().and_then(|e| e.thermal);
+        if let Some(m) = thermal.filter(|_| gap.is_finite() && gap > 0.0 && warm.is_finite()) {
+            self.state.x[extension::SLOT_TEMP] = warm * (-gap / m.time_constant()).exp();
+        }
+    }
+
     /// Advance by `dt` seconds with inputs held constant over the step and
     /// return the outputs at the end of the step. On error the state is unchanged.
     ///

@@ -131,7 +131,8 @@ fn relaxation_replay_beats_steady_on_lagged_truth() {
 /// recording goes on after a gap. The replay restarts its slip states at
 /// the gap but carries the tread temperature, cooled over the gap without
 /// frictional power: ΔT·exp(−gap·h/C) — for a 0.3 s drop-out 0.1 % cooler
-/// than without the gap, for 600 s e^−2 of it; when the time runs
+/// than without the gap, for 600 s e^−2 of it, for a repeated time stamp
+/// (a zero step, which restarts the replay) unchanged; when the time runs
 /// backwards (concatenated files) the second part starts at ambient. The
 /// temperature is read back from each step's friction scale
 /// (s = 1 − 0.2·ΔT/50 K, at the step's start), settling time 0 so that the
@@ -153,12 +154,19 @@ fn the_tread_temperature_carries_over_a_gap_and_cools() {
     let tyre = Tyre::new(p).unwrap();
     let tau: f64 = 12_000.0 / 40.0;
     let n = 12_000;
+    // The second half's times moved by `shift`; by exactly one spacing
+    // back (`REPEAT`) its first time stamp repeats the one before it.
+    const REPEAT: f64 = -0.01;
     let at = |shift: f64| -> Vec<tyrekit::data::Sample> {
         (0..n)
             .map(|i| {
                 let t = 0.01 * i as f64;
                 tyrekit::data::Sample {
-                    time: if i >= n / 2 { t + shift } else { t },
+                    time: match (i >= n / 2, shift == REPEAT) {
+                        (false, _) => t,
+                        (true, true) => 0.01 * (i - 1) as f64,
+                        (true, false) => t + shift,
+                    },
                     vx: 15.0,
                     omega: f64::NAN,
                     fz: 4000.0,
@@ -202,6 +210,7 @@ fn the_tread_temperature_carries_over_a_gap_and_cools() {
     for (shift, expect, what) in [
         (0.3, warm * (-0.31 / tau).exp(), "a 0.3 s drop-out"),
         (600.0, warm * (-600.01 / tau).exp(), "a 600 s pause"),
+        (REPEAT, warm, "a repeated time stamp"),
         (-60.0, 0.0, "time running backwards"),
     ] {
         let (got, runs) = after_gap(shift);

@@ -13,8 +13,8 @@
 //!   warm-up cut, concatenated files, dropped rows). A continuous recording
 //!   is *not* reset at segment starts: the rig runs through its transitions
 //!   without stopping, so the tyre's state carries over physically. At a
-//!   gap of positive duration the tread temperature of a `[THERMAL]` tyre
-//!   carries over, cooled over the gap
+//!   gap whose time runs forward (or stands: a repeated time stamp) the
+//!   tread temperature of a `[THERMAL]` tyre carries over, cooled over the gap
 //!   ([`TransientModel::reset_after_gap`]): a logger drop-out of a fraction
 //!   of a second does not cool a tyre whose time constant is minutes, and
 //!   a reset to ambient at each one would make a thermal model fail on any

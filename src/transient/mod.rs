@@ -469,13 +469,14 @@ impl TransientModel {
     /// tread temperature of a `[THERMAL]` extension (slot 3), whose time
     /// constant is minutes, carries over, cooled over the gap without
     /// frictional power: ΔT·exp(−gap·h/C), the heat balance of
-    /// [`extension`] with P = 0. A gap that is not a finite positive time
-    /// (time running backwards: concatenated files) resets everything.
+    /// [`extension`] with P = 0 (a repeated time stamp, gap 0, keeps it as
+    /// it is). A gap that is not a finite time ≥ 0 (time running backwards:
+    /// concatenated files) resets everything.
     pub fn reset_after_gap(&mut self, tyre: &Tyre, gap: f64) {
         let warm = self.state.x[extension::SLOT_TEMP];
         self.reset();
         let thermal = tyre.extension().and_then(|e| e.thermal);
-        if let Some(m) = thermal.filter(|_| gap.is_finite() && gap > 0.0 && warm.is_finite()) {
+        if let Some(m) = thermal.filter(|_| gap.is_finite() && gap >= 0.0 && warm.is_finite()) {
             self.state.x[extension::SLOT_TEMP] = warm * (-gap / m.time_constant()).exp();
         }
     }

@@ -249,6 +249,41 @@ const DEAD_ALPHA_DEG: f64 = 3.0;
 /// steady-state TYDEX sweep of a few points per side is left unjudged.
 const DEAD_MIN_ROWS: usize = 20;
 
+/// How channels per unit load change across a recording's slip, the
+/// statistic of the dead-channel checks: over the loaded rows with finite
+/// values, those whose slip lies `lo ≤ ±(slip − median slip) ≤ hi` above
+/// and below the median; for each of `values` (divided by Fz) the median
+/// above minus the median below, and the two row counts. `None` when
+/// either side holds fewer than [`DEAD_MIN_ROWS`] rows (unjudged).
+fn change_across_slip<const N: usize>(
+    samples: &[Sample],
+    slip: fn(&Sample) -> f64,
+    values: [fn(&Sample) -> f64; N],
+    (lo, hi): (f64, f64),
+) -> Option<([f64; N], usize, usize)> {
+    let fmax = max_abs_fz(samples);
+    let rows: Vec<(f64, [f64; N])> = samples
+        .iter()
+        .filter(|s| loaded(s, fmax) && s.fz > 0.0)
+        .map(|s| (slip(s), values.map(|v| v(s) / s.fz)))
+        .filter(|(x, v)| x.is_finite() && v.iter().all(|y| y.is_finite()))
+        .collect();
+    let mid = median(rows.iter().map(|r| r.0))?;
+    let side = |sign: f64| -> Vec<&[f64; N]> {
+        rows.iter()
+            .filter(|(x, _)| (lo..=hi).contains(&(sign * (x - mid))))
+            .map(|(_, v)| v)
+            .collect()
+    };
+    let (pos, neg) = (side(1.0), side(-1.0));
+    if pos.len() < DEAD_MIN_ROWS || neg.len() < DEAD_MIN_ROWS {
+        return None;
+    }
+    let med = |v: &[&[f64; N]], k: usize| median(v.iter().map(|r| r[k])).unwrap_or(f64::NAN);
+    let change = std::array::from_fn(|k| med(&pos, k) - med(&neg, k));
+    Some((change, pos.len(), neg.len()))
+}
+
 /// Force channels that do not follow their slip: Fx against κ, Fy against
 /// α. On the loaded rows with finite values, the rows at slip ≥ median +
 /// threshold and ≤ median − threshold (κ 0.05, α 3°) are compared; where
@@ -263,7 +298,6 @@ pub(crate) fn check_dead_forces(
     channels: &mut Vec<String>,
     report: &mut LoadReport,
 ) {
-    let fmax = max_abs_fz(samples);
     type Get = fn(&Sample) -> f64;
     type Show = fn(f64) -> String;
     let checks: [(&str, &str, Get, Get, f64, &str, Show); 2] = [
@@ -291,27 +325,11 @@ pub(crate) fn check_dead_forces(
         if !has(force) || !has(slip_ch) {
             continue;
         }
-        let rows: Vec<(f64, f64)> = samples
-            .iter()
-            .filter(|s| loaded(s, fmax) && s.fz > 0.0)
-            .map(|s| (slip(s), f(s) / s.fz))
-            .filter(|(x, r)| x.is_finite() && r.is_finite())
-            .collect();
-        let Some(mid) = median(rows.iter().map(|r| r.0)) else {
+        let Some(([d], np, nn)) =
+            change_across_slip(samples, slip, [f], (threshold, f64::INFINITY))
+        else {
             continue;
         };
-        let side = |sign: f64| -> Vec<f64> {
-            rows.iter()
-                .filter(|(x, _)| sign * (x - mid) >= threshold)
-                .map(|r| r.1)
-                .collect()
-        };
-        let (pos, neg) = (side(1.0), side(-1.0));
-        if pos.len() < DEAD_MIN_ROWS || neg.len() < DEAD_MIN_ROWS {
-            continue;
-        }
-        let (np, nn) = (pos.len(), neg.len());
-        let d = median(pos).unwrap_or(f64::NAN) - median(neg).unwrap_or(f64::NAN);
         if d.abs() < DEAD_FORCE {
             let step = show(threshold);
             reject(
@@ -364,34 +382,15 @@ pub(crate) fn check_dead_moment(
     if !has("Mz") || !has("Fy") || !has("alpha") {
         return;
     }
-    let fmax = max_abs_fz(samples);
-    let rows: Vec<(f64, f64, f64)> = samples
-        .iter()
-        .filter(|s| loaded(s, fmax) && s.fz > 0.0)
-        .map(|s| (s.alpha, s.fy / s.fz, s.mz / s.fz))
-        .filter(|(a, y, z)| a.is_finite() && y.is_finite() && z.is_finite())
-        .collect();
-    let Some(mid) = median(rows.iter().map(|r| r.0)) else {
-        return;
-    };
-    let (lo, hi) = (
+    let band = (
         DEAD_MZ_ALPHA_DEG.0.to_radians(),
         DEAD_MZ_ALPHA_DEG.1.to_radians(),
     );
-    let side = |sign: f64| -> (Vec<f64>, Vec<f64>) {
-        rows.iter()
-            .filter(|(a, _, _)| (lo..=hi).contains(&(sign * (a - mid))))
-            .map(|&(_, y, z)| (y, z))
-            .unzip()
-    };
-    let ((py, pz), (ny, nz)) = (side(1.0), side(-1.0));
-    if pz.len() < DEAD_MIN_ROWS || nz.len() < DEAD_MIN_ROWS {
+    let Some(([dy, dz], np, nn)) =
+        change_across_slip(samples, |s| s.alpha, [|s| s.fy, |s| s.mz], band)
+    else {
         return;
-    }
-    let (np, nn) = (pz.len(), nz.len());
-    let d =
-        |a: Vec<f64>, b: Vec<f64>| median(a).unwrap_or(f64::NAN) - median(b).unwrap_or(f64::NAN);
-    let (dy, dz) = (d(py, ny), d(pz, nz));
+    };
     if dy.abs() < DEAD_FORCE || !dy.is_finite() {
         return;
     }

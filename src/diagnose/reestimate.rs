@@ -404,7 +404,10 @@ pub fn build_extended(
     };
     match of {
         FileOf::Candidate(c) => {
-            let plain = match refit_on_all(rec, tyre, opts, c) {
+            let t_refit = crate::fit::timing::span(|| format!("refit {} on all", c.name()));
+            let plain = refit_on_all(rec, tyre, opts, c);
+            drop(t_refit);
+            let plain = match plain {
                 Ok(p) => p,
                 Err(e) => {
                     b.refit_failed = Some(e.to_string());
@@ -416,6 +419,8 @@ pub fn build_extended(
             b.fitted = Some(match refit.filter(|_| c.reestimable()) {
                 Some(f) => {
                     step("re-estimate baseline");
+                    let _t =
+                        crate::fit::timing::span(|| format!("re-estimate beneath {}", c.name()));
                     let r = reestimate(rec, tyre, opts, c, plain, f);
                     b.reestimated = Some((r.rounds, r.cost_plain, r.cost, r.failed));
                     r.fitted

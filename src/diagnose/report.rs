@@ -284,12 +284,15 @@ pub fn diagnose_with(
     // Locate (permutation tests) on a second thread while the candidates fit.
     let (findings, ev) = std::thread::scope(|s| {
         let h = s.spawn(|| {
+            let _t = crate::fit::timing::span(|| "locate (every channel)".into());
             channels
                 .iter()
                 .map(|&ch| (ch, locate_channel(rec, &base.sim, &energy, ch)))
                 .collect::<Vec<_>>()
         });
+        let _t = crate::fit::timing::span(|| "candidates (fit on half, scored)".into());
         let ev = evaluate(rec, tyre, opts, &cands);
+        drop(_t);
         (h.join(), ev)
     });
     let findings =

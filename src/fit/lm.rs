@@ -9,9 +9,10 @@
 //! residuals and n ≈ 25 parameters the normal equations are the better
 //! trade: JᵀWJ (n×n) is accumulated block by block — a problem offering
 //! [`Problem::row_jacobian`] fills 128-row blocks that are multiplied into
-//! the upper triangle while in L1, on its threads, in fixed 8192-row chunks
-//! summed in chunk order (so the result does not depend on the thread
-//! count), and the m×n J is never stored; other problems write J into a
+//! the upper triangle while in L1, on its threads, in fixed 2048-row chunks
+//! handed to whichever thread is free and summed in chunk order (so the
+//! result does not depend on the thread count), and the m×n J is never
+//! stored; other problems write J into a
 //! buffer allocated once per fit — and everything after it is n×n work.
 //! The normal equations square
 //! the condition number, which is acceptable here because collinear or
@@ -414,9 +415,17 @@ struct Partial {
 
 /// The linearisation by row blocks of a [`RowJacobian`]: each block's r and
 /// J are computed into a small buffer, weighted by √ω (IRLS), and their
-/// upper-triangle JᵀJ and Jᵀr added to the chunk's partial; chunks are
-/// spread over `threads` scoped threads and their partials summed in chunk
-/// order. The m × k Jacobian is never stored.
+/// upper-triangle JᵀJ and Jᵀr added to the chunk's partial; the chunks are
+/// handed out one at a time to `threads` scoped threads (whichever is free
+/// takes the next) and their partials summed in chunk order. The m × k
+/// Jacobian is never stored.
+///
+/// Handing chunks out one at a time, not in contiguous halves: a stacked
+/// problem's rows cost unequal amounts (the combined stage's Mz rows, last in
+/// the stack, cost several times its Fx rows), and with halves the thread
+/// holding the Mz rows did ≈ 80 % of the work while the other waited. Which
+/// thread computes a chunk does not change its partial, and the partials are
+/// still added in chunk order: the result is bit-identical to the serial one.
 #[allow(clippy::too_many_arguments)]
 fn linearise_rows(
     rows: &dyn super::problem::RowJacobian,
@@ -428,68 +437,80 @@ fn linearise_rows(
 ) -> (DMatrix<f64>, DVector<f64>, f64, f64) {
     let unit = w.is_none() && loss.kind == super::loss::LossKind::Linear;
     let n_chunks = m.div_ceil(CHUNK_ROWS).max(1);
-    let mut parts: Vec<Partial> = (0..n_chunks)
-        .map(|_| Partial {
+    // One chunk's partial, computed block by block in row order.
+    let chunk = |ci: usize, r: &mut [f64], jac: &mut [f64]| -> Partial {
+        let mut part = Partial {
             a: DMatrix::zeros(k, k),
             g: DVector::zeros(k),
             cost: 0.0,
             wrss: 0.0,
-        })
-        .collect();
-    let work = |c0: usize, parts: &mut [Partial]| {
-        let mut r = vec![0.0; BLOCK_ROWS];
-        let mut jac = vec![0.0; BLOCK_ROWS * k];
-        for (ci, part) in parts.iter_mut().enumerate() {
-            let chunk_start = (c0 + ci) * CHUNK_ROWS;
-            let chunk_end = (chunk_start + CHUNK_ROWS).min(m);
-            let mut b0 = chunk_start;
-            while b0 < chunk_end {
-                let nb = BLOCK_ROWS.min(chunk_end - b0);
-                let (rb, jb) = (&mut r[..nb], &mut jac[..nb * k]);
-                rows.rows(b0, rb, &mut DMatrixViewMut::from_slice(jb, nb, k));
-                for i in 0..nb {
-                    let (c, om) = loss.cost_and_weight(rb[i], w.map_or(1.0, |w| w[b0 + i]));
-                    part.cost += c;
-                    part.wrss += om * rb[i] * rb[i];
-                    if !unit {
-                        let s = om.sqrt();
-                        rb[i] *= s;
-                        for j in 0..k {
-                            jb[j * nb + i] *= s;
-                        }
+        };
+        let chunk_start = ci * CHUNK_ROWS;
+        let chunk_end = (chunk_start + CHUNK_ROWS).min(m);
+        let mut b0 = chunk_start;
+        while b0 < chunk_end {
+            let nb = BLOCK_ROWS.min(chunk_end - b0);
+            let (rb, jb) = (&mut r[..nb], &mut jac[..nb * k]);
+            rows.rows(b0, rb, &mut DMatrixViewMut::from_slice(jb, nb, k));
+            for i in 0..nb {
+                let (c, om) = loss.cost_and_weight(rb[i], w.map_or(1.0, |w| w[b0 + i]));
+                part.cost += c;
+                part.wrss += om * rb[i] * rb[i];
+                if !unit {
+                    let s = om.sqrt();
+                    rb[i] *= s;
+                    for j in 0..k {
+                        jb[j * nb + i] *= s;
                     }
                 }
-                gram_add(jb, nb, k, rb, &mut part.a, &mut part.g);
-                b0 += nb;
             }
+            gram_add(jb, nb, k, rb, &mut part.a, &mut part.g);
+            b0 += nb;
+        }
+        part
+    };
+    // Take chunks from the shared counter until none is left.
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let work = || -> Vec<(usize, Partial)> {
+        let mut r = vec![0.0; BLOCK_ROWS];
+        let mut jac = vec![0.0; BLOCK_ROWS * k];
+        let mut done = Vec::new();
+        loop {
+            let ci = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            if ci >= n_chunks {
+                return done;
+            }
+            done.push((ci, chunk(ci, &mut r, &mut jac)));
         }
     };
     let threads = threads.clamp(1, n_chunks);
+    let mut slots: Vec<Option<Partial>> = (0..n_chunks).map(|_| None).collect();
+    let mut place = |done: Vec<(usize, Partial)>| {
+        for (ci, p) in done {
+            slots[ci] = Some(p);
+        }
+    };
     if threads == 1 {
-        work(0, &mut parts);
+        place(work());
     } else {
         std::thread::scope(|s| {
-            let mut rest: &mut [Partial] = &mut parts;
-            let mut c0 = 0;
-            for t in 0..threads {
-                let take = (n_chunks * (t + 1)) / threads - (n_chunks * t) / threads;
-                let (mine, tail) = rest.split_at_mut(take);
-                rest = tail;
-                let work = &work;
-                let start = c0;
-                if t + 1 == threads {
-                    work(start, mine);
-                } else {
-                    s.spawn(move || work(start, mine));
+            let others: Vec<_> = (1..threads).map(|_| s.spawn(work)).collect();
+            place(work());
+            for h in others {
+                // A panic in a worker is re-raised here, as the serial
+                // path would raise it.
+                match h.join() {
+                    Ok(done) => place(done),
+                    Err(e) => std::panic::resume_unwind(e),
                 }
-                c0 += take;
             }
         });
     }
+    let parts = slots.into_iter().map(|p| p.expect("every chunk computed"));
     let mut a = DMatrix::zeros(k, k);
     let mut g = DVector::zeros(k);
     let (mut cost, mut wrss) = (0.0, 0.0);
-    for p in &parts {
+    for p in parts {
         a += &p.a;
         g += &p.g;
         cost += p.cost;
@@ -888,5 +909,75 @@ mod tests {
         assert!((&a - &a_ref).amax() < 1e-12 * amax);
         assert!((&g - &g_ref).amax() < 1e-12 * g_ref.amax());
         assert_eq!(a, a.transpose());
+    }
+
+    /// Rows of a fixed J and r; rows past `slow_from` spin before returning
+    /// (the combined stage's costly Mz rows at the end of its stack), so the
+    /// threads finish their chunks in an order that differs from run to run.
+    struct Rows {
+        j: DMatrix<f64>,
+        r: Vec<f64>,
+        slow_from: usize,
+    }
+
+    impl super::super::problem::RowJacobian for Rows {
+        fn rows(&self, first: usize, r: &mut [f64], jac: &mut DMatrixViewMut<f64>) {
+            for (i, ri) in r.iter_mut().enumerate() {
+                let row = first + i;
+                if row >= self.slow_from {
+                    let mut x = 1.0f64;
+                    for _ in 0..200 {
+                        x = std::hint::black_box(x.sqrt() + 1.0);
+                    }
+                }
+                *ri = self.r[row];
+                for c in 0..self.j.ncols() {
+                    jac[(i, c)] = self.j[(row, c)];
+                }
+            }
+        }
+    }
+
+    /// The blocked linearisation hands chunks to whichever thread is free;
+    /// the partials are added in chunk order, so JᵀΩJ, JᵀΩr and the cost are
+    /// bit-identical for every thread count (with and without IRLS weights),
+    /// and agree with the plain product to rounding.
+    #[test]
+    fn row_linearisation_is_bit_identical_for_any_thread_count() {
+        let (m, k) = (3 * CHUNK_ROWS + 777, 5);
+        let j = DMatrix::from_fn(m, k, |i, c| ((i * 37 + c * 11) % 89) as f64 / 89.0 - 0.3);
+        let r: Vec<f64> = (0..m).map(|i| ((i * 7) % 31) as f64 / 3.0 - 5.0).collect();
+        let rows = Rows {
+            j: j.clone(),
+            r: r.clone(),
+            slow_from: 2 * CHUNK_ROWS,
+        };
+        let w: Vec<f64> = (0..m).map(|i| 0.5 + (i % 3) as f64).collect();
+        for (weights, loss) in [
+            (None, Loss::default()),
+            (Some(&w[..]), Loss::default()),
+            (
+                None,
+                Loss {
+                    kind: super::super::loss::LossKind::Huber,
+                    scale: 2.0,
+                },
+            ),
+        ] {
+            let one = linearise_rows(&rows, m, k, weights, &loss, 1);
+            for t in [2, 3, 8] {
+                let many = linearise_rows(&rows, m, k, weights, &loss, t);
+                assert_eq!(one.0, many.0, "JᵀΩJ, {t} threads");
+                assert_eq!(one.1, many.1, "JᵀΩr, {t} threads");
+                assert_eq!(one.2.to_bits(), many.2.to_bits(), "cost, {t} threads");
+                assert_eq!(one.3.to_bits(), many.3.to_bits(), "ΩRSS, {t} threads");
+            }
+            if weights.is_none() && loss.kind == super::super::loss::LossKind::Linear {
+                let a_ref = j.tr_mul(&j);
+                assert!((&one.0 - &a_ref).amax() < 1e-12 * a_ref.amax());
+                let g_ref = j.tr_mul(&DVector::from_column_slice(&r));
+                assert!((&one.1 - &g_ref).amax() < 1e-12 * g_ref.amax());
+            }
+        }
     }
 }

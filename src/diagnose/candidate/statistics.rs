@@ -328,6 +328,7 @@ pub fn evaluate(
             let Some(c) = candidates.get(i) else {
                 break;
             };
+            let _t = crate::fit::timing::span(|| format!("candidate {}", c.name()));
             let r = c
                 .fit(rec, baseline, opts, &fit_mask, &w)
                 .and_then(|fitted| {

@@ -788,8 +788,8 @@ fn devset_verdicts_hold_with_twice_the_zero_errors() {
 /// Prints a variation's verdicts and asserts that none is wrong (each is
 /// the answer's effect or `none`, so every control stays `none`) and that
 /// no fewer effects are named than before: over all 21 at least
-/// `named_before`, over a [`Sample`] at least as many as its last full run
-/// named among the sample's recordings.
+/// `named_before`, over a [`Sample`] at least as many of the sample's
+/// recordings as were named when it was last measured ([`Sample::named`]).
 fn no_wrong_name(
     v: &[(String, String, String)],
     what: &str,

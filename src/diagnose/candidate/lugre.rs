@@ -4,6 +4,7 @@
 //! a value the fit did not produce.
 
 use super::param::{nominal_props, p, param, ParamCandidate, Spec, Target};
+use super::work::Memory;
 use super::Reestimation;
 use super::{FX, FY, MZ};
 use crate::mf::Tyre;
@@ -11,12 +12,18 @@ use crate::residual::ReplayOptions;
 use crate::transient::lugre::SECTION as LUGRE_SECTION;
 use crate::transient::TransientKind;
 
+/// Lowest bristle stiffness fitted, as a fraction of the start.
+const LOWEST: f64 = 0.05;
+
 fn lugre_spec(t: &Tyre, o: &ReplayOptions) -> Option<Spec> {
     let s = nominal_props(t, o);
     let fz0 = t.params().p.fnomin.max(1.0);
     // Start: bristles lagging like a 0.3 m relaxation length, K/(Fz0·0.3 m).
     let s0 = |k: f64| (k.abs() / (fz0 * 0.3)).clamp(1.0, 1e5);
     let (sx, sy) = (s0(s.kxk), s0(s.kya));
+    // At small slip the bristles lag like a relaxation length K/(Fz0·σ0):
+    // the longest at the lowest stiffness of the range.
+    let lag = (s.kxk.abs() / (fz0 * LOWEST * sx)).max(s.kya.abs() / (fz0 * LOWEST * sy));
     let sec = |k| vec![Target::Section(LUGRE_SECTION, k)];
     Some(Spec {
         params: vec![
@@ -24,7 +31,7 @@ fn lugre_spec(t: &Tyre, o: &ReplayOptions) -> Option<Spec> {
                 "SIGMA0X",
                 sec("SIGMA0X"),
                 sx,
-                0.05 * sx,
+                LOWEST * sx,
                 20.0 * sx,
                 0.02 * sx,
             )
@@ -33,7 +40,7 @@ fn lugre_spec(t: &Tyre, o: &ReplayOptions) -> Option<Spec> {
                 "SIGMA0Y",
                 sec("SIGMA0Y"),
                 sy,
-                0.05 * sy,
+                LOWEST * sy,
                 20.0 * sy,
                 0.02 * sy,
             )
@@ -41,7 +48,7 @@ fn lugre_spec(t: &Tyre, o: &ReplayOptions) -> Option<Spec> {
             p("MUS", sec("MUS"), 1.0, 0.7, 2.0, 0.01),
         ],
         kind: Some(TransientKind::LuGre),
-        sequential: true,
+        memory: Memory::rolled(lag),
         prescan: 2,
         ..Spec::default()
     })

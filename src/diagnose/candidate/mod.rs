@@ -21,13 +21,17 @@
 //! LM = the crate's one Levenberg–Marquardt ([`crate::fit::lm`], bounded by
 //! projection) behind [`crate::fit::Problem`]; the candidate's Jacobian is
 //! a forward difference of the replay (the transient models are `f64`
-//! code, see [`param`]), ≤ 7 parameters. Static candidates (no state) are
-//! fitted on at most [`STATIC_SAMPLES`] fit-half samples and never replay
-//! a transient.
+//! code, see [`param`]), ≤ 7 parameters. Each trial replays as little of
+//! the recording as the model's memory allows ([`work`]): static
+//! candidates (no state) at most [`STATIC_SAMPLES`] fit-half samples, never
+//! a transient; relaxation and LuGre the fit half's runs, each from a
+//! warm-up of three of the longest lag lengths their ranges allow; thermal
+//! the whole recording on a coarser time grid.
 //!
 //! # Files
 //! One file per candidate (its [`Spec`] and its description in words),
-//! [`param`] (the parametrised candidate and its fit), the statistics
+//! [`param`] (the parametrised candidate and its fit), [`work`] (what a
+//! fit replays at each trial), the statistics
 //! ([`statistics`]: split, input smoothing, weights, evaluation) and the
 //! verdict rule ([`selection`]).
 //!
@@ -98,6 +102,7 @@ pub mod selection;
 mod speed_friction;
 pub mod statistics;
 mod thermal;
+pub mod work;
 
 /// Index of Fx, Fy, Mz in [`crate::residual::Channel::SCORED`] (and in the weights).
 pub use crate::residual::{FX, FY, MZ};

@@ -9,6 +9,7 @@
 //! parameter whose channels carry no data, or report a value at a bound
 //! without saying so ([`Fitted::at_bound`]).
 
+use super::work::{work, Memory};
 use super::{Candidate, Fitted, Reestimation, ALL_CHANNELS};
 use crate::data::Recording;
 use crate::error::Result;
@@ -247,8 +248,11 @@ pub struct Spec {
     pub fixed: Vec<(Target, f64)>,
     /// Transient model to replay with (None: the baseline's).
     pub kind: Option<TransientKind>,
-    /// The model has a state: replay the whole recording in time order.
-    pub sequential: bool,
+    /// What the model remembers between samples: how much of the
+    /// recording each trial replays ([`super::work`]). A static candidate
+    /// replayed under a transient model of the diagnosis's options
+    /// replays the whole recording.
+    pub memory: Memory,
     /// Re-derive κ from the tyre's effective rolling radius.
     pub kappa_re: bool,
     /// Before LM, scan one common factor on the start values of the first
@@ -583,13 +587,6 @@ pub struct ParamCandidate {
     pub reestimation: Reestimation,
 }
 
-/// Fit-half sample indices, thinned to at most `max` (evenly).
-fn thin(mask: &[bool], max: usize) -> Vec<usize> {
-    let idx: Vec<usize> = (0..mask.len()).filter(|&i| mask[i]).collect();
-    let step = idx.len().div_ceil(max.max(1)).max(1);
-    idx.into_iter().step_by(step).collect()
-}
-
 impl Candidate for ParamCandidate {
     fn name(&self) -> &'static str {
         self.name
@@ -646,21 +643,11 @@ impl Candidate for ParamCandidate {
         if let Some(k) = spec.kind {
             ro.kind = k;
         }
-        let sequential = spec.sequential || ro.kind != TransientKind::Steady;
-        // Static: a thinned copy of the fit half (no state, so order and
-        // gaps do not matter). Sequential: the whole recording replayed,
-        // residuals on the fit half only.
-        let (work, idx): (Recording, Vec<usize>) = if sequential {
-            (rec.clone(), thin(mask, 4 * STATIC_SAMPLES))
-        } else {
-            let idx = thin(mask, STATIC_SAMPLES);
-            let sub = Recording {
-                samples: idx.iter().map(|&i| rec.samples[i]).collect(),
-                ..Default::default()
-            };
-            let n = idx.len();
-            (sub, (0..n).collect())
+        let memory = match spec.memory {
+            Memory::None | Memory::Slow if ro.kind != TransientKind::Steady => Memory::Whole,
+            m => m,
         };
+        let (work, idx) = work(rec, mask, memory);
         // The full parameter vector from the free ones.
         let full = |th: &[f64]| -> Vec<f64> {
             let mut t: Vec<f64> = spec.params.iter().map(|q| q.init).collect();

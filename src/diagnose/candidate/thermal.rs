@@ -18,6 +18,7 @@
 //! a value the fit did not produce.
 
 use super::param::{p, param, ParamCandidate, Spec, Target};
+use super::work::Memory;
 use super::Reestimation;
 use crate::mf::Tyre;
 use crate::residual::ReplayOptions;
@@ -61,7 +62,7 @@ fn thermal_spec(t: &Tyre, _: &ReplayOptions) -> Option<Spec> {
             p("MU_T2", vec![th("MU_T2")], 0.0, -1.0, 1.0, 0.002),
         ],
         fixed: vec![(th("COOLING"), h), (th("SHARE"), 0.5)],
-        sequential: true,
+        memory: Memory::Slow,
         ..Spec::default()
     })
 }

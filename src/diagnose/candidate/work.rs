@@ -252,4 +252,73 @@ mod tests {
             assert!(t < 200.0 || (500.0..900.0).contains(&t), "{t}");
         }
     }
+
+    /// The physics the windows rely on: on a swept recording (α and κ
+    /// never at rest), the relaxation and LuGre models replayed on the
+    /// windows give the forces of the whole replay on every sample the
+    /// residual reads, to 1e-9 of the largest force, with the warm-up the
+    /// candidates use (three of their longest lags: 20× the built-in tyre's
+    /// relaxation length) — the state has forgotten the window's settled
+    /// start; with no warm-up at all (runs starting mid-sweep) they do not
+    /// (the check can fail).
+    #[test]
+    fn window_replays_agree_with_the_whole_replay_where_the_residual_reads() {
+        use crate::mf::Tyre;
+        use crate::residual::{replay, ReplayOptions};
+        use crate::transient::TransientKind;
+        let tyre = Tyre::builtin();
+        let n = 3000;
+        let r = Recording {
+            samples: (0..n)
+                .map(|i| {
+                    let t = i as f64 * 0.01;
+                    let tau = std::f64::consts::TAU;
+                    Sample {
+                        time: t,
+                        vx: 11.0,
+                        omega: f64::NAN,
+                        fz: 3000.0 + 800.0 * (tau * t / 7.0).sin(),
+                        kappa: 0.05 * (tau * t / 3.0).sin(),
+                        alpha: 6f64.to_radians() * (tau * t / 4.0).sin(),
+                        p: f64::NAN,
+                        ..Default::default()
+                    }
+                })
+                .collect(),
+            ..Default::default()
+        };
+        let m = mask(n, &[(530, 900), (1510, 2000), (2470, 2900)]);
+        let o = ReplayOptions::default();
+        let props = super::super::param::nominal_props(&tyre, &o);
+        let lag = 20.0 * props.sigmax.max(props.sigmay);
+        for kind in [TransientKind::Relaxation, TransientKind::LuGre] {
+            let o = ReplayOptions { kind, ..o };
+            let whole = replay(&r, &tyre, &o).unwrap().sim;
+            let fmax = whole
+                .iter()
+                .map(|f| f.fx.abs().max(f.fy.abs()))
+                .fold(0.0, f64::max);
+            let worst = |lag: f64| {
+                let (w, idx) = work(&r, &m, Memory::Rolled(lag));
+                let sim = replay(&w, &tyre, &o).unwrap().sim;
+                let read = thin(&m, FIT_SAMPLES);
+                idx.iter()
+                    .zip(&read)
+                    .map(|(&j, &i)| {
+                        let (a, b) = (sim[j], whole[i]);
+                        (a.fx - b.fx)
+                            .abs()
+                            .max((a.fy - b.fy).abs())
+                            .max((a.mz - b.mz).abs())
+                    })
+                    .fold(0.0, f64::max)
+            };
+            let (with, without) = (worst(lag), worst(1e-9));
+            assert!(with <= 1e-9 * fmax, "{kind:?}: {with} N of {fmax} N");
+            assert!(
+                without > 1e-3 * fmax,
+                "{kind:?}: {without} N without warm-up"
+            );
+        }
+    }
 }

@@ -249,9 +249,9 @@ pub struct Spec {
     /// Transient model to replay with (None: the baseline's).
     pub kind: Option<TransientKind>,
     /// What the model remembers between samples: how much of the
-    /// recording each trial replays ([`super::work`]). A static candidate
-    /// replayed under a transient model of the diagnosis's options
-    /// replays the whole recording.
+    /// recording each trial replays ([`super::work`]). A static or slow
+    /// candidate replayed under a transient model of the diagnosis's
+    /// options (`--transient`) replays the whole recording.
     pub memory: Memory,
     /// Re-derive κ from the tyre's effective rolling radius.
     pub kappa_re: bool,

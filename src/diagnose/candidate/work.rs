@@ -39,6 +39,7 @@
 
 use super::STATIC_SAMPLES;
 use crate::data::Recording;
+use crate::diagnose::baseline::decimate;
 use crate::residual::median_spacing;
 
 /// Most fit-half samples the residual of a candidate with a state reads.
@@ -95,9 +96,8 @@ pub fn work(rec: &Recording, mask: &[bool], memory: Memory) -> (Recording, Vec<u
         Memory::Slow => {
             let n_fit = mask.iter().filter(|x| **x).count();
             let k = n_fit.div_ceil(FIT_SAMPLES).max(1);
-            let kept: Vec<usize> = (0..rec.samples.len()).step_by(k).collect();
-            let sub_mask: Vec<bool> = kept.iter().map(|&i| mask[i]).collect();
-            (pick(rec, &kept), thin(&sub_mask, FIT_SAMPLES))
+            let sub_mask: Vec<bool> = mask.iter().step_by(k).copied().collect();
+            (decimate(rec, k), thin(&sub_mask, FIT_SAMPLES))
         }
         Memory::Rolled(lag) => {
             let read = thin(mask, FIT_SAMPLES);

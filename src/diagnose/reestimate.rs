@@ -289,21 +289,21 @@ fn rounds(
         let next = refit_on_all(rec, &Tyre::new(mf.clone())?, opts, candidate)?;
         let (c, per) = cost(rec, &next.predict(rec)?, &all, &w);
         if !kept((c, &per), best.cost, &per_plain) {
-            if crate::fit::timing::enabled() {
-                eprintln!(
-                    "timing:   round {round} not kept (in-sample error {c:.6e} against {:.6e})",
+            crate::fit::timing::note(|| {
+                format!(
+                    "  round {round} not kept (in-sample error {c:.6e} against {:.6e})",
                     best.cost
-                );
-            }
+                )
+            });
             break;
         }
         let gain = 1.0 - c / best.cost;
-        if crate::fit::timing::enabled() {
-            eprintln!(
-                "timing:   round {round} kept: in-sample error -{:.3} %",
+        crate::fit::timing::note(|| {
+            format!(
+                "  round {round} kept: in-sample error -{:.3} %",
                 100.0 * gain
-            );
-        }
+            )
+        });
         best.fitted = next;
         best.rounds = round;
         best.cost = c;

@@ -560,9 +560,9 @@ fn polish(
             Some(&mut cb),
         )?;
         theta = res.theta;
-        if super::timing::enabled() {
-            eprintln!(
-                "timing:       {stage}: LM round {round} on {} rows: cost {:.6e} -> {:.6e}, {} linearisations, {} trial evaluations, {:?}{}",
+        super::timing::note(|| {
+            format!(
+                "      {stage}: LM round {round} on {} rows: cost {:.6e} -> {:.6e}, {} linearisations, {} trial evaluations, {:?}{}",
                 problem.n_residuals(),
                 res.initial_cost,
                 res.cost,
@@ -570,8 +570,8 @@ fn polish(
                 res.residual_evals,
                 res.termination,
                 if loose { " (loose)" } else { "" }
-            );
-        }
+            )
+        });
         iterations += res.iterations;
         termination = res.termination;
         cost = res.cost;

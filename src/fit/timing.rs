@@ -53,3 +53,12 @@ pub fn span(label: impl FnOnce() -> String) -> Option<Span> {
         cpu: cpu_seconds(),
     })
 }
+
+/// Print `timing: ` and the line made by `line()` (only called when timing
+/// is on): a figure of the run that is not a span (an LM round's costs, a
+/// re-estimation round's gain).
+pub fn note(line: impl FnOnce() -> String) {
+    if enabled() {
+        eprintln!("timing: {}", line());
+    }
+}

@@ -9,8 +9,8 @@
 
 use crate::common;
 
-use tyrekit::fit::channels::{eval, eval_given};
-use tyrekit::fit::mf_stages::{conditions_of, Channel};
+use tyrekit::fit::channels::{eval, eval_from, eval_given};
+use tyrekit::fit::mf_stages::{conditions_of, Channel, StageKind};
 use tyrekit::mf::num_dual::Dual64;
 use tyrekit::mf::{form_of, Model};
 use tyrekit::tir::keys::key_index;
@@ -138,6 +138,90 @@ fn moments_given_their_force_are_the_one_channel_values() {
                 }
                 let v = eval_given(&mf, &c, ch, Some(f));
                 assert_eq!(v.to_bits(), eval(&mf, &c, ch).to_bits());
+            }
+        }
+    }
+}
+
+/// Every key of the aligning-torque and combined-slip stage tables: the
+/// parameters whose stages take the pure-slip terms as given.
+fn mz_and_combined_keys() -> Vec<&'static str> {
+    [StageKind::Mz, StageKind::Combined]
+        .iter()
+        .flat_map(|k| k.table().iter().map(|e| e.0))
+        .collect()
+}
+
+/// Every `step`-th sample's conditions and its pure-slip terms under `m0`.
+fn conditions_and_terms(
+    t: &TyreParams,
+    m0: &Model,
+    step: usize,
+) -> (Vec<tyrekit::mf::Conditions>, Vec<tyrekit::mf::PureTerms>) {
+    let conds: Vec<_> = samples(t)
+        .iter()
+        .step_by(step)
+        .map(|s| conditions_of(&t.p, s))
+        .collect();
+    let terms = conds.iter().map(|c| m0.pure_terms(c)).collect();
+    (conds, terms)
+}
+
+#[test]
+fn pure_terms_are_unmoved_by_the_mz_and_combined_coefficients() {
+    // The Mz and combined stages compute each sample's pure-slip terms once,
+    // from the start tyre, and move only the keys of their tables. So for a
+    // tyre with any one of those keys changed, the channels from the
+    // *unchanged* tyre's terms must be the same bits as evaluated afresh; a
+    // table key that entered Fx0, Fy0 or Fy0 at γ = 0 would fail here.
+    for t in tyres() {
+        let form = form_of(t.version);
+        let (conds, terms) = conditions_and_terms(&t, &Model::new(t.p.clone(), form), 5);
+        // `None`: the unchanged tyre itself.
+        for k in std::iter::once(None).chain(mz_and_combined_keys().into_iter().map(Some)) {
+            let ki = k.map(|k| key_index(k).unwrap());
+            let p =
+                t.p.map(|i, v| if Some(i) == ki { v * 1.3 + 0.02 } else { v });
+            let m = Model::new(p, form);
+            for (c, pt) in conds.iter().zip(&terms) {
+                for ch in CHANNELS {
+                    let (a, b) = (eval_from(&m, c, ch, pt), eval(&m, c, ch));
+                    let same = a.to_bits() == b.to_bits();
+                    assert!(same, "{} {k:?} {ch:?}: {a} vs {b}", t.source);
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn channels_from_pure_terms_carry_the_derivatives_of_mz_and_combined_keys() {
+    // With one of those keys seeded, value and derivative from the given
+    // terms agree with the full evaluation to rounding (1e-12 relative, as
+    // above), and the derivative is not trivially zero everywhere.
+    for t in tyres() {
+        let m0 = Model::new(t.p.clone(), form_of(t.version));
+        let (conds, terms) = conditions_and_terms(&t, &m0, 9);
+        for k in mz_and_combined_keys() {
+            let m = seeded(&t, k);
+            let mut moved = false;
+            for (c, pt) in conds.iter().zip(&terms) {
+                for ch in [Channel::Fx, Channel::Fy, Channel::Mz] {
+                    let (a, b) = (eval_from(&m, c, ch, pt), eval(&m, c, ch));
+                    moved |= b.eps != 0.0;
+                    for (what, x, y) in [("value", a.re, b.re), ("derivative", a.eps, b.eps)] {
+                        assert!(
+                            (x - y).abs() <= 1e-12 * y.abs().max(1e-300),
+                            "{} {ch:?} {what} (d/d{k}): {x} vs {y}",
+                            t.source
+                        );
+                    }
+                }
+            }
+            // A key the file leaves at zero can be inert (e.g. a camber
+            // term times a zero scaling); report, do not fail.
+            if !moved {
+                eprintln!("{}: {k} moves none of Fx, Fy, Mz here", t.source);
             }
         }
     }

@@ -11,7 +11,7 @@
 //! with turn slip (the fitter's use mode has none).
 
 use super::mf_stages::Channel;
-use crate::mf::{Conditions, Model, Real};
+use crate::mf::{Conditions, Model, PureTerms, Real};
 
 /// `channel` of `model` at `c`: the same value as `channel.of(&model.solve(c))`.
 #[inline]
@@ -47,5 +47,24 @@ pub fn eval_given<T: Real>(
         (Channel::Mx, Some(fy)) => model.mx_with_fy(c, T::c(fy)),
         (Channel::My, Some(fx)) => model.my_with_fx(c, T::c(fx)),
         _ => eval(model, c, channel),
+    }
+}
+
+/// [`eval`] from the sample's pure-slip terms ([`Model::pure_terms`] of the
+/// `f64` model with the same coefficients): valid when no parameter that
+/// moves them carries a dual lane — the aligning-torque and combined-slip
+/// coefficients of the Mz and combined stages move none. Only what follows
+/// the pure-slip forces is evaluated in `T` (Gxα for Fx, Gyκ and SVyκ for
+/// Fy, the aligning torque for Mz). In `f64` the same bits as [`eval`];
+/// with dual lanes the same to rounding (`tests/fit_channels.rs`).
+#[inline]
+pub fn eval_from<T: Real>(model: &Model<T>, c: &Conditions, channel: Channel, t: &PureTerms) -> T {
+    match channel {
+        Channel::Fx => model.fx_from(c, t),
+        Channel::Fy => model.fy_from(c, t),
+        Channel::Mz => model.mz_from(c, t),
+        Channel::Mx => model.mx_with_fy(c, model.fy_from(c, t)),
+        Channel::My => model.my_with_fx(c, model.fx_from(c, t)),
+        Channel::Fz => T::from(f64::NAN),
     }
 }

@@ -33,7 +33,7 @@
 use super::channels;
 use super::grad_pure;
 use super::problem::{par_rows, Param, Problem, RowJacobian};
-use crate::mf::{Conditions, Form, Model};
+use crate::mf::{Conditions, Form, Model, PureTerms};
 use crate::tir::keys::key_index;
 use crate::tir::MfParams;
 use nalgebra::{Const, DMatrixViewMut, U1};
@@ -75,6 +75,11 @@ pub struct MfStage<'a> {
     /// combined-slip Fy (Fx) of every sample, which θ cannot move
     /// ([`channels::eval_given`]).
     given: Option<Vec<f64>>,
+    /// Fx, Fy and Mz stages whose every parameter is an aligning-torque or
+    /// combined-slip coefficient (the Mz and combined tables): the
+    /// pure-slip terms of every sample, which θ cannot move
+    /// ([`channels::eval_from`]).
+    pure: Option<Vec<PureTerms>>,
     /// Threads for evaluation (results do not depend on it).
     pub threads: usize,
 }
@@ -149,6 +154,13 @@ impl<'a> MfStage<'a> {
                     .map(|c| channels::eval(&model, c, f))
                     .collect()
             });
+        let pure = (given.is_none()
+            && matches!(channel, Channel::Fx | Channel::Fy | Channel::Mz)
+            && moves_no_pure_term(&params))
+        .then(|| {
+            let model = Model::new(base.clone(), form);
+            data.conds.iter().map(|c| model.pure_terms(c)).collect()
+        });
         let stage = MfStage {
             form,
             base: base.clone(),
@@ -160,6 +172,7 @@ impl<'a> MfStage<'a> {
             weights: None,
             analytic: None,
             given,
+            pure,
             threads: 1,
         };
         Ok(stage.with_analytic(true))
@@ -240,6 +253,18 @@ impl<'a> MfStage<'a> {
     }
 }
 
+/// Whether every parameter is an aligning-torque or combined-slip
+/// coefficient (the Mz and combined stages' tables, by name): none of them
+/// enters [`Model::pure_terms`] (`tests/fit_channels.rs` perturbs each).
+fn moves_no_pure_term(params: &[Param]) -> bool {
+    let tables = [StageKind::Mz.table(), StageKind::Combined.table()];
+    params.iter().all(|p| {
+        tables
+            .iter()
+            .any(|t| t.iter().any(|e| e.0.eq_ignore_ascii_case(&p.name)))
+    })
+}
+
 /// `base` with θ written in at the key indices `keys`
 /// ([`MfParams::as_slice`] order).
 pub(crate) fn params_with(base: &MfParams<f64>, keys: &[usize], theta: &[f64]) -> MfParams<f64> {
@@ -297,6 +322,7 @@ struct DualRows<'s> {
     meas: &'s [f64],
     channel: Channel,
     given: Option<&'s [f64]>,
+    pure: Option<&'s [PureTerms]>,
 }
 
 impl DualRows<'_> {
@@ -312,12 +338,11 @@ impl DualRows<'_> {
     ) {
         for (k, rk) in r.iter_mut().enumerate() {
             let i = first + k;
-            let y = channels::eval_given(
-                model,
-                &self.conds[i],
-                self.channel,
-                self.given.map(|g| g[i]),
-            );
+            let c = &self.conds[i];
+            let y = match self.pure {
+                Some(t) => channels::eval_from(model, c, self.channel, &t[i]),
+                None => channels::eval_given(model, c, self.channel, self.given.map(|g| g[i])),
+            };
             if col0 == 0 {
                 *rk = y.re - self.meas[i];
             }
@@ -362,12 +387,16 @@ impl Problem for MfStage<'_> {
         }
         let model = Model::new(p, self.form);
         let given = self.given.as_deref();
+        let pure = self.pure.as_deref();
         par_rows(self.threads, 0, r, None, &|first, r: &mut [f64], _| {
             for (k, rk) in r.iter_mut().enumerate() {
                 let i = first + k;
-                *rk =
-                    channels::eval_given(&model, &self.conds[i], self.channel, given.map(|g| g[i]))
-                        - self.meas[i];
+                let c = &self.conds[i];
+                let y = match pure {
+                    Some(t) => channels::eval_from(&model, c, self.channel, &t[i]),
+                    None => channels::eval_given(&model, c, self.channel, given.map(|g| g[i])),
+                };
+                *rk = y - self.meas[i];
             }
         });
     }
@@ -438,6 +467,7 @@ impl Problem for MfStage<'_> {
             meas: self.meas,
             channel: self.channel,
             given: self.given.as_deref(),
+            pure: self.pure.as_deref(),
         }))
     }
     fn threads(&self) -> usize {

@@ -126,6 +126,70 @@ struct Spin<T> {
     eps_g: T,
 }
 
+impl Spin<f64> {
+    fn lift<T: Real>(self) -> Spin<T> {
+        Spin {
+            phi: T::c(self.phi),
+            eps_g: T::c(self.eps_g),
+        }
+    }
+}
+
+impl Fy0<f64> {
+    fn lift<T: Real>(self) -> Fy0<T> {
+        Fy0 {
+            fy0: T::c(self.fy0),
+            muy: T::c(self.muy),
+            kya: T::c(self.kya),
+            shape: T::c(self.shape),
+            shy: T::c(self.shy),
+            svy: T::c(self.svy),
+            by: T::c(self.by),
+            cy: T::c(self.cy),
+            zeta2: T::c(self.zeta2),
+        }
+    }
+}
+
+impl Pure<f64> {
+    fn lift<T: Real>(self) -> Pure<T> {
+        Pure {
+            dfz: T::c(self.dfz),
+            dpi: T::c(self.dpi),
+            spin: self.spin.map(Spin::lift),
+            fx0: T::c(self.fx0),
+            mux: T::c(self.mux),
+            kxk: T::c(self.kxk),
+            f: self.f.lift(),
+        }
+    }
+}
+
+/// The pure-slip part of one sample's solution ([`Model::pure_terms`]):
+/// normalised load and pressure, Fx0 with μx and Kxκ (4.E9–4.E18), Fy0 with
+/// its shifts and slopes (4.E19–4.E30), and Fy0 at γ = 0 for the aligning
+/// torque (4.E74). No aligning-torque (QBZ…, QCZ…, QDZ…, QEZ…, QHZ…, PPZ…)
+/// or combined-slip (R…, SSZ…) coefficient enters them, so a fit stage that
+/// moves only those computes them once per sample in `f64`
+/// ([`crate::fit::channels::eval_from`]) instead of
+/// once per dual-number pass.
+#[derive(Clone, Copy)]
+pub struct PureTerms {
+    r: Pure<f64>,
+    f0: Fy0<f64>,
+}
+
+impl Model<f64> {
+    /// The pure-slip terms of `c` (no friction scale, no step terms), the
+    /// same bits as [`Model::solve`] computes on its way.
+    pub fn pure_terms(&self, c: &Conditions) -> PureTerms {
+        let mut fl = 0u32;
+        let r = self.pure(c, 1.0, true, true, None, &mut fl);
+        let f0 = self.fy0_upright(c, &r, self.p.lmuy, &mut fl);
+        PureTerms { r, f0 }
+    }
+}
+
 /// The slip-independent pure-slip terms of one load, pressure and camber:
 /// μx (4.E13), Kxκ (4.E15, with its exp) and the load shape of Kyα (4.E25,
 /// its sin(PKY4·atan(…))), as [`Model::zero_slip_terms`] computed them. A
@@ -767,6 +831,33 @@ impl<T: Real> Model<T> {
         self.my(c, fx)
     }
 
+    /// Combined-slip Fx from the sample's pure-slip terms
+    /// ([`Model::pure_terms`], computed with the same coefficients): the
+    /// same value as [`Model::fx_only`] (in `f64` the same bits), with only
+    /// Gxα (4.E50–4.E57) evaluated in `T`.
+    pub(crate) fn fx_from(&self, c: &Conditions, t: &PureTerms) -> T {
+        let mut fl = 0u32;
+        let r: Pure<T> = t.r.lift();
+        self.gxa(c, r.dfz, T::c(c.gamma_star) * self.lgax, &mut fl) * r.fx0
+    }
+
+    /// Combined-slip Fy from the pure-slip terms, as [`Model::fy_only`]:
+    /// only Gyκ and SVyκ (4.E58–4.E67) evaluated in `T`.
+    pub(crate) fn fy_from(&self, c: &Conditions, t: &PureTerms) -> T {
+        let mut fl = 0u32;
+        let r: Pure<T> = t.r.lift();
+        let (gyk, svyk_unit) = self.gyk(c, r.dfz, T::c(c.gamma_star) * self.lgay, &mut fl);
+        gyk * r.f.fy0 + svyk_unit * r.f.muy * r.f.zeta2
+    }
+
+    /// The aligning torque from the pure-slip terms: [`Model::solve`]'s Mz
+    /// (without My; in `f64` the same bits), evaluating in `T` only what
+    /// follows the pure-slip forces.
+    pub(crate) fn mz_from(&self, c: &Conditions, t: &PureTerms) -> T {
+        let (r, f0): (Pure<T>, Fy0<T>) = (t.r.lift(), t.f0.lift());
+        self.finish(c, 1.0, false, &r, &f0, 0).mz
+    }
+
     /// Normalised load and pressure change (4.E2a, 4.E2b), as in `pure`.
     #[inline(always)]
     fn load_pressure(&self, c: &Conditions) -> (T, T) {
@@ -805,12 +896,50 @@ impl<T: Real> Model<T> {
         my: bool,
         pre: Option<&LoadTerms<T>>,
     ) -> Solution<T> {
+        let mut fl = 0u32;
+        let r = self.pure(c, mu_scale, true, true, pre, &mut fl);
+        let f0 = self.fy0_upright(c, &r, self.p.lmuy * mu_scale, &mut fl);
+        self.finish(c, mu_scale, my, &r, &f0, fl)
+    }
+
+    /// Fy0 at γ = 0 (with Gyκ at the original γ*, as MFeval does to match
+    /// TNO) for the aligning torque's Fy' (4.E74): the pure lateral force
+    /// already computed when γ* = 0.
+    #[inline(always)]
+    fn fy0_upright(&self, c: &Conditions, r: &Pure<T>, lmuy: T, fl: &mut u32) -> Fy0<T> {
+        if c.gamma_star == 0.0 {
+            r.f
+        } else {
+            // With PKY5 = 0 the load shape of Kyα does not depend on γ
+            // (value-only: the same operands give the same bits).
+            let shape = if self.skip_pky5 {
+                Some(r.f.shape)
+            } else {
+                None
+            };
+            // The MF-Tyre 5.2 Mz takes only μy at γ = 0 from it, not Fy0.
+            let force = !self.is52();
+            self.fy0(c, r.dfz, r.dpi, T::c(0.0), r.spin, lmuy, shape, force, fl)
+        }
+    }
+
+    /// [`Model::solve_with`] from its pure-slip part `r` and the upright
+    /// Fy0 `f0`: the combined-slip forces (4.E50–4.E67), the aligning
+    /// torque (4.E31–4.E49, 4.E71–4.E78) and Mx, My.
+    #[inline(always)]
+    fn finish(
+        &self,
+        c: &Conditions,
+        mu_scale: f64,
+        my: bool,
+        r: &Pure<T>,
+        f0: &Fy0<T>,
+        mut fl: u32,
+    ) -> Solution<T> {
         let p = &self.p;
         let lmuy = p.lmuy * mu_scale;
         let inv_lmuy = self.inv_lmuy * (1.0 / mu_scale);
-        let mut fl = 0u32;
         let one = T::c(1.0);
-        let r = self.pure(c, mu_scale, true, true, pre, &mut fl);
         let (dfz, dpi, spin, mux, kxk, f) = (r.dfz, r.dpi, r.spin, r.mux, r.kxk, r.f);
         let gs = T::c(c.gamma_star);
         let g = T::c(c.gamma);
@@ -852,7 +981,7 @@ impl<T: Real> Model<T> {
             fl |= Clamped::ET;
         }
 
-        let (fx, fy, gyk, svyk_unit) = self.combined(c, &r, &mut fl);
+        let (fx, fy, gyk, svyk_unit) = self.combined(c, r, &mut fl);
 
         let (zeta0, zeta6, zeta7, zeta8) = match spin {
             Some(s) => {
@@ -924,18 +1053,7 @@ impl<T: Real> Model<T> {
         } else {
             dr * (cr * (br * ar_eq).arctan()).cos()
         } * c.smooth; // 4.E75
-                      // Fy at γ = 0 (and Gyκ with the original γ*, as MFeval does to match TNO).
-        let f0 = if c.gamma_star == 0.0 {
-            // γ* = 0: the lateral force at γ = 0 is the one just computed.
-            f
-        } else {
-            // With PKY5 = 0 the load shape of Kyα does not depend on γ
-            // (value-only: the same operands give the same bits).
-            let shape = if self.skip_pky5 { Some(f.shape) } else { None };
-            // The MF-Tyre 5.2 Mz takes only μy at γ = 0 from it, not Fy0.
-            let force = !self.is52();
-            self.fy0(c, dfz, dpi, T::c(0.0), spin, lmuy, shape, force, &mut fl)
-        };
+                      // Fy at γ = 0: `f0` (`fy0_upright`).
         let svyk0 = svyk_unit * f0.muy;
         let fy_prime = gyk * f0.fy0; // 4.E74
         let bat = bt * at_eq;

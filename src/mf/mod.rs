@@ -55,7 +55,7 @@ pub mod limits;
 pub mod real;
 pub mod validate;
 
-pub use equations::{Form, LoadTerms, Model, Solution};
+pub use equations::{Form, LoadTerms, Model, PureTerms, Solution};
 pub use limits::{Clamped, Conditions};
 pub use real::Real;
 

@@ -374,11 +374,29 @@ pub const LM_FTOL: f64 = 1e-5;
 /// (Madsen, Nielsen & Tingleff, *Methods for non-linear least squares
 /// problems*, 2004, §3.3). A θ whose model cannot be built or replayed has
 /// non-finite residuals (LM rejects the step); its difference column is 0.
+/// The last replay's (θ, r) is kept: LM linearises at the trial it has just
+/// accepted, whose residuals the Jacobian then reuses instead of replaying
+/// again (the replay is deterministic, so the same numbers).
 struct FdProblem<F: Fn(&[f64]) -> Option<Vec<f64>>> {
     params: Vec<crate::fit::Param>,
     steps: Vec<f64>,
     m: usize,
     resid: F,
+    last: std::cell::RefCell<Option<(Vec<f64>, Vec<f64>)>>,
+}
+
+impl<F: Fn(&[f64]) -> Option<Vec<f64>>> FdProblem<F> {
+    /// r(θ), from the last replay when it was at this θ (bit for bit).
+    fn at(&self, theta: &[f64]) -> Option<Vec<f64>> {
+        if let Some((t, r)) = self.last.borrow().as_ref() {
+            if t.iter().zip(theta).all(|(a, b)| a.to_bits() == b.to_bits()) {
+                return Some(r.clone());
+            }
+        }
+        let r = (self.resid)(theta)?;
+        *self.last.borrow_mut() = Some((theta.to_vec(), r.clone()));
+        Some(r)
+    }
 }
 
 impl<F: Fn(&[f64]) -> Option<Vec<f64>>> crate::fit::Problem for FdProblem<F> {
@@ -389,7 +407,7 @@ impl<F: Fn(&[f64]) -> Option<Vec<f64>>> crate::fit::Problem for FdProblem<F> {
         self.m
     }
     fn residuals(&self, theta: &[f64], r: &mut [f64]) {
-        match (self.resid)(theta) {
+        match self.at(theta) {
             Some(v) if v.len() == r.len() => r.copy_from_slice(&v),
             _ => r.fill(f64::NAN),
         }
@@ -437,6 +455,7 @@ fn fit_lm(params: &[Param], resid: impl Fn(&[f64]) -> Option<Vec<f64>>) -> Vec<f
         steps: params.iter().map(|q| q.h).collect(),
         m: r0.len(),
         resid,
+        last: std::cell::RefCell::new(Some((start.clone(), r0))),
     };
     let opts = crate::fit::LmOptions {
         max_iter: LM_ITERATIONS,
@@ -445,7 +464,18 @@ fn fit_lm(params: &[Param], resid: impl Fn(&[f64]) -> Option<Vec<f64>>) -> Vec<f
         ..Default::default()
     };
     let free = vec![true; params.len()];
-    crate::fit::lm::minimize(&problem, &start, &free, &opts, None).map_or(start, |r| r.theta)
+    match crate::fit::lm::minimize(&problem, &start, &free, &opts, None) {
+        Ok(r) => {
+            crate::fit::timing::note(|| {
+                format!(
+                    "    LM: {} linearisations, {} trials, {:?}, cost {:.4e} -> {:.4e}",
+                    r.iterations, r.residual_evals, r.termination, r.initial_cost, r.cost
+                )
+            });
+            r.theta
+        }
+        Err(_) => start,
+    }
 }
 
 /// Per channel block of a candidate's residual vector (blocks of `n`, the
@@ -673,7 +703,9 @@ impl Candidate for ParamCandidate {
                 held: vec![],
             })
         };
+        let replays = std::sync::atomic::AtomicUsize::new(0);
         let resid = |theta: &[f64]| -> Option<Vec<f64>> {
+            replays.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
             let m = model_of(theta).ok()?;
             let sim = m.sim(&work).ok()?;
             let mut out = Vec::with_capacity(3 * idx.len());
@@ -744,6 +776,15 @@ impl Candidate for ParamCandidate {
                 (keep, theta) = eliminate(&params, theta, &secs, &base, &resid, idx.len());
             }
         }
+        crate::fit::timing::note(|| {
+            format!(
+                "  {}: {} replays of {} samples ({} read)",
+                self.name,
+                replays.load(std::sync::atomic::Ordering::Relaxed),
+                work.samples.len(),
+                idx.len()
+            )
+        });
         let mut m = model_of(&theta)?;
         m.held = params
             .iter()

@@ -9,7 +9,11 @@
 //! `DualSVec64` for these equations: 8 lanes ≈ 0.6 µs, 16 ≈ 0.9 µs, 32 ≈
 //! 6 µs per pure-Fy sample on the project machine), and only the fitted
 //! channel is evaluated ([`super::channels`], the same operations as
-//! [`crate::mf::Model::solve`]).
+//! [`crate::mf::Model::solve`]). The Mz and combined-slip stages move no
+//! pure-slip coefficient, so each sample's pure-slip terms are computed once
+//! in `f64` ([`crate::mf::Model::pure_terms`]) and only what follows them
+//! carries dual lanes ([`super::channels::eval_from`]); likewise the Mx
+//! (My) stage takes the sample's Fy (Fx) as given.
 //!
 //! Stage contents follow the usual industrial order (Pacejka, *Tyre and
 //! Vehicle Dynamics*, 3rd ed., §4.3.2 and Table 4.2): pure slip Fx

@@ -37,7 +37,7 @@
 use super::channels;
 use super::grad_pure;
 use super::problem::{par_rows, Param, Problem, RowJacobian};
-use crate::mf::{Conditions, Form, Model, PureTerms};
+use crate::mf::{Conditions, Form, Model, PureTerms, Real};
 use crate::tir::keys::key_index;
 use crate::tir::MfParams;
 use nalgebra::{Const, DMatrixViewMut, U1};
@@ -269,6 +269,24 @@ fn moves_no_pure_term(params: &[Param]) -> bool {
     })
 }
 
+/// A stage's `channel` at its sample `i` (conditions `c`), from the
+/// sample's pure-slip terms or the force its moment needs where the stage
+/// keeps them ([`MfStage`]'s `pure`, `given`).
+#[inline(always)]
+fn channel_at<T: Real>(
+    model: &Model<T>,
+    c: &Conditions,
+    channel: Channel,
+    given: Option<&[f64]>,
+    pure: Option<&[PureTerms]>,
+    i: usize,
+) -> T {
+    match pure {
+        Some(t) => channels::eval_from(model, c, channel, &t[i]),
+        None => channels::eval_given(model, c, channel, given.map(|g| g[i])),
+    }
+}
+
 /// `base` with θ written in at the key indices `keys`
 /// ([`MfParams::as_slice`] order).
 pub(crate) fn params_with(base: &MfParams<f64>, keys: &[usize], theta: &[f64]) -> MfParams<f64> {
@@ -342,11 +360,14 @@ impl DualRows<'_> {
     ) {
         for (k, rk) in r.iter_mut().enumerate() {
             let i = first + k;
-            let c = &self.conds[i];
-            let y = match self.pure {
-                Some(t) => channels::eval_from(model, c, self.channel, &t[i]),
-                None => channels::eval_given(model, c, self.channel, self.given.map(|g| g[i])),
-            };
+            let y = channel_at(
+                model,
+                &self.conds[i],
+                self.channel,
+                self.given,
+                self.pure,
+                i,
+            );
             if col0 == 0 {
                 *rk = y.re - self.meas[i];
             }
@@ -395,11 +416,7 @@ impl Problem for MfStage<'_> {
         par_rows(self.threads, 0, r, None, &|first, r: &mut [f64], _| {
             for (k, rk) in r.iter_mut().enumerate() {
                 let i = first + k;
-                let c = &self.conds[i];
-                let y = match pure {
-                    Some(t) => channels::eval_from(&model, c, self.channel, &t[i]),
-                    None => channels::eval_given(&model, c, self.channel, given.map(|g| g[i])),
-                };
+                let y = channel_at(&model, &self.conds[i], self.channel, given, pure, i);
                 *rk = y - self.meas[i];
             }
         });

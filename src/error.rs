@@ -14,16 +14,23 @@ pub enum Error {
     /// A `.tir` property file could not be read or understood.
     #[error("{file}:{line}: {key}: {message}")]
     Tir {
+        /// The file's name or path, as given by the caller.
         file: String,
+        /// 1-based line of the offending entry (0 when the problem is not on one line).
         line: usize,
+        /// The `.tir` key concerned, e.g. `FNOMIN` ("" when it concerns no key).
         key: String,
+        /// What is wrong and what was expected.
         message: String,
     },
     /// A recording (TTC .mat/.dat, TYDEX, CSV) could not be read.
     #[error("{file}: {location}: {message}")]
     Recording {
+        /// The recording's name or path, as given by the caller.
         file: String,
+        /// Where in it, in the format's own terms (e.g. "line 12", "channel 'FZ'", "gzip").
         location: String,
+        /// What is wrong and what was expected.
         message: String,
     },
     /// An input value is outside what the model can evaluate.
@@ -35,7 +42,9 @@ pub enum Error {
     /// I/O on a named path.
     #[error("{path}: {source}")]
     Io {
+        /// The path that was being read or written.
         path: PathBuf,
+        /// The underlying I/O error.
         #[source]
         source: std::io::Error,
     },

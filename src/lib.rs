@@ -13,6 +13,9 @@
 //! Conventions: ISO-W (TYDEX W) axes and SI units everywhere inside the crate.
 //! Conversions happen only at the edges (`.tir` `[UNITS]`, SAE/TTC recordings).
 
+// Every public item says what it is (CI's clippy runs with -D warnings).
+#![warn(missing_docs)]
+
 pub mod brush;
 pub mod data;
 pub mod diagnose;

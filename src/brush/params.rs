@@ -85,8 +85,12 @@ pub struct BrushParams {
     pub r0: f64,
     /// Vertical stiffness (N/m).
     pub cz: f64,
-    /// Contact-length coefficients of the MF file.
+    /// Q_RA1 of the MF 6.x tyre file (dimensionless): the √(ρ/R0) coefficient of
+    /// the contact half length a = R0·(Q_RA2·ρ/R0 + Q_RA1·√(ρ/R0)), ρ = Fz/Cz
+    /// (see [`half_length`](super::half_length)).
     pub q_ra1: f64,
+    /// Q_RA2 of the MF 6.x tyre file (dimensionless): the linear ρ/R0 coefficient
+    /// of the same contact half length.
     pub q_ra2: f64,
 }
 

@@ -82,17 +82,34 @@ impl AxisSystem {
 /// Quantities whose sign depends on the axis system.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Quantity {
+    /// Longitudinal force Fx (N), along x; in ISO-W positive forward (driving).
     Fx,
+    /// Lateral force Fy (N), along y (ISO-W: positive to the left; SAE: to the right).
     Fy,
+    /// Normal force Fz (N), along z; ISO-W (z up): positive when the road
+    /// presses on the tyre, SAE (z down): negative.
     Fz,
+    /// Overturning moment Mx (N·m), about x.
     Mx,
+    /// Rolling-resistance moment My (N·m), about y.
     My,
+    /// Self-aligning moment Mz (N·m), about z.
     Mz,
+    /// Slip angle α (rad), a rotation about z; ISO-W: positive when the contact
+    /// centre moves towards +y (so Fy < 0), adapted ISO: same sign as Fy.
     SlipAngle,
+    /// Inclination angle γ (rad), a rotation about x; positive for a positive
+    /// rotation about x (ISO-W: wheel top towards −y, to the right).
     Inclination,
+    /// Longitudinal slip ratio κ (–), positive when driving in every system.
     SlipRatio,
+    /// Turn slip φt (1/m): the wheel's yaw rate over its contact-centre speed,
+    /// a path curvature (Pacejka: φt = −ψ̇/Vc), signed about z.
     TurnSlip,
+    /// Forward speed Vx (m/s) of the wheel centre, along x.
     Speed,
+    /// Wheel spin rate Ω (rad/s), stored as the forward rolling speed
+    /// (positive rolling forward) whatever the axes.
     WheelSpin,
 }
 
@@ -100,12 +117,17 @@ pub enum Quantity {
 /// system onto ISO-W (`iso = factor * recorded`).
 #[derive(Clone, Copy, Debug)]
 pub struct SignRow {
+    /// The quantity this row maps.
     pub quantity: Quantity,
     /// Label for tables.
     pub label: &'static str,
+    /// Factor (±1) from SAE J670 (FSAE TTC / Calspan) to ISO-W.
     pub sae: f64,
+    /// Factor (±1) from ISO-W to ISO-W: always +1.
     pub iso: f64,
+    /// Factor (±1) from Pacejka's adapted ISO to ISO-W (−1 for α only).
     pub adapted_iso: f64,
+    /// Factor (±1) from TYDEX W to ISO-W: always +1 (the same axes).
     pub tydex_w: f64,
     /// TYDEX C: factor before the γ rotation / moment transfer.
     pub tydex_c: f64,
@@ -281,15 +303,26 @@ pub fn sign_table_markdown() -> String {
 /// A force/moment/kinematics record in some axis system (SI units).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct AxisSample {
+    /// Longitudinal force Fx (N), along the sample system's x axis.
     pub fx: f64,
+    /// Lateral force Fy (N), along the sample system's y axis.
     pub fy: f64,
+    /// Normal force Fz (N), along the sample system's z axis (ISO-W: positive
+    /// on a loaded tyre; SAE: negative).
     pub fz: f64,
+    /// Overturning moment Mx (N·m), about x.
     pub mx: f64,
+    /// Rolling-resistance moment My (N·m), about y.
     pub my: f64,
+    /// Self-aligning moment Mz (N·m), about z.
     pub mz: f64,
+    /// Slip angle α (rad), with the sample system's sign.
     pub alpha: f64,
+    /// Inclination angle γ (rad), with the sample system's sign.
     pub gamma: f64,
+    /// Longitudinal slip ratio κ (–), positive when driving.
     pub kappa: f64,
+    /// Turn slip φt (1/m), with the sample system's sign.
     pub phit: f64,
     /// Loaded radius (m), needed for TYDEX C only.
     pub rl: f64,

@@ -81,15 +81,18 @@ impl Format {
 /// One column as stored in a file.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RawColumn {
+    /// Column name as written in the file (a `[unit]` suffix may still be attached).
     pub name: String,
     /// Unit as written in the file (`None` when the file gives none).
     pub unit: Option<String>,
+    /// Values as stored, in the file's units and axes.
     pub data: Vec<f64>,
 }
 
 /// A file's content before interpretation: columns with names and units.
 #[derive(Clone, Debug, Default)]
 pub struct RawTable {
+    /// The columns, in file order.
     pub columns: Vec<RawColumn>,
     /// Header/metadata entries (TTC `source`, `testid`, `tireid`; TYDEX header …).
     pub meta: Vec<(String, String)>,
@@ -186,8 +189,11 @@ impl Default for LoadOptions {
 /// What loading did to the file: the honest account users need.
 #[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct LoadReport {
+    /// Path of the file, as given.
     pub file: String,
+    /// Format the file was read as (`Format` debug name, e.g. `TtcMat`).
     pub format: String,
+    /// Axis system the file was read in (an [`AxisSystem::name`]), before conversion to ISO-W.
     pub axes: String,
     /// Rows in the file.
     pub rows_read: usize,
@@ -218,7 +224,9 @@ pub struct LoadReport {
 /// A loaded recording with its report.
 #[derive(Clone, Debug)]
 pub struct Loaded {
+    /// The recording, ISO-W SI.
     pub recording: Recording,
+    /// What loading did to the file.
     pub report: LoadReport,
 }
 

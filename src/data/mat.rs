@@ -49,22 +49,41 @@ mod mx {
 #[derive(Clone, Debug, PartialEq)]
 pub enum MatValue {
     /// Numeric or logical array, column-major, real part converted to f64.
-    Numeric { dims: Vec<usize>, data: Vec<f64> },
+    Numeric {
+        /// Array dimensions in MATLAB order (rows, columns, …).
+        dims: Vec<usize>,
+        /// Values in column-major order.
+        data: Vec<f64>,
+    },
     /// Character array (rows joined with '\n' when more than one row).
-    Char { dims: Vec<usize>, text: String },
+    Char {
+        /// Array dimensions as stored (rows, columns).
+        dims: Vec<usize>,
+        /// The characters, one line per row, trailing NULs and blanks trimmed.
+        text: String,
+    },
     /// Struct array: field names and, per element, one value per field.
     Struct {
+        /// Dimensions of the struct array (1×1 for a scalar struct).
         dims: Vec<usize>,
+        /// Field names, in stored order.
         fields: Vec<String>,
+        /// One entry per struct element (column-major); each holds the
+        /// values in the order of `fields`.
         elements: Vec<Vec<MatValue>>,
     },
     /// Cell array, column-major.
     Cell {
+        /// Dimensions of the cell array.
         dims: Vec<usize>,
+        /// The cells, column-major.
         items: Vec<MatValue>,
     },
     /// A class this reader does not decode (objects such as `table`, sparse …).
-    Unsupported { class: String },
+    Unsupported {
+        /// What the value is (e.g. "sparse"), with advice where there is some.
+        class: String,
+    },
 }
 
 impl MatValue {
@@ -136,6 +155,7 @@ fn dims_str(d: &[usize]) -> String {
 pub struct MatError {
     /// Variable (or "header") the problem was found in, with byte offset.
     pub location: String,
+    /// What is wrong, in words.
     pub message: String,
 }
 

@@ -33,19 +33,29 @@ pub struct Sample {
     pub phit: f64,
     /// Inflation pressure (Pa).
     pub p: f64,
+    /// Longitudinal force Fx (N), positive forward (driving).
     pub fx: f64,
+    /// Lateral force Fy (N), positive towards +y (left).
     pub fy: f64,
+    /// Overturning moment Mx (N·m), about x.
     pub mx: f64,
+    /// Rolling-resistance moment My (N·m), about y.
     pub my: f64,
+    /// Self-aligning moment Mz (N·m), about z.
     pub mz: f64,
 }
 
 /// Kind of a test segment.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum SegmentKind {
+    /// Slip angle α swept at constant slip ratio κ (cornering sweep).
     PureLateral,
+    /// Slip ratio κ (or, without a κ channel, Fx/Fz) swept at α ≈ 0 (within
+    /// the slip-angle set-point tolerance).
     PureLongitudinal,
+    /// κ swept at a non-zero slip angle, or α and κ both swept.
     Combined,
+    /// Neither α nor κ swept (e.g. free rolling at a set point).
     Other,
 }
 
@@ -68,12 +78,18 @@ pub struct Segment {
     pub start: usize,
     /// Last sample index (exclusive).
     pub end: usize,
+    /// What the segment sweeps.
     pub kind: SegmentKind,
-    /// Set points (binned): load (N), inclination (rad), pressure (Pa), speed (m/s), slip angle (rad, drive/brake runs).
+    /// Load set point Fz (N): median over the segment. The set points are
+    /// medians of the binned runs ([`structure`](super::structure)).
     pub fz: f64,
+    /// Inclination set point γ (rad): median over the segment.
     pub gamma: f64,
+    /// Inflation pressure set point (Pa): median over the segment.
     pub p: f64,
+    /// Speed set point (m/s): median of Vx/cos α, i.e. the road (belt) speed.
     pub vx: f64,
+    /// Slip-angle set point α (rad) of a drive/brake run; NaN when α is swept.
     pub alpha: f64,
 }
 

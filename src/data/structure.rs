@@ -29,15 +29,17 @@ use crate::stats::median_in_place;
 /// Tolerances used for binning set points.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct SegmentOptions {
-    /// Load tolerance: max(abs, rel·Fz) (N, –).
+    /// Absolute part of the load tolerance max(`fz_abs`, `fz_rel`·Fz) (N).
     pub fz_abs: f64,
+    /// Relative part of the load tolerance (–, fraction of Fz).
     pub fz_rel: f64,
     /// Inclination tolerance (rad).
     pub gamma_tol: f64,
     /// Pressure tolerance (Pa).
     pub p_tol: f64,
-    /// Speed tolerance: max(abs, rel·V) (m/s, –).
+    /// Absolute part of the speed tolerance max(`v_abs`, `v_rel`·V) (m/s).
     pub v_abs: f64,
+    /// Relative part of the speed tolerance (–, fraction of V).
     pub v_rel: f64,
     /// Slip-angle set-point tolerance for drive/brake runs (rad).
     pub alpha_tol: f64,
@@ -68,8 +70,9 @@ impl Default for SegmentOptions {
 pub struct WarmupCut {
     /// Samples removed from the beginning.
     pub samples: usize,
-    /// Time span removed (s).
+    /// Time of the first sample removed (s).
     pub t_start: f64,
+    /// Time of the first sample kept (s); the cut is `t_start` ≤ t < `t_end`.
     pub t_end: f64,
     /// Why, in words.
     pub reason: String,

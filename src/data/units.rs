@@ -7,15 +7,25 @@
 /// Physical dimension a channel must have.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Dim {
+    /// Time, stored in s.
     Time,
+    /// Linear speed, stored in m/s.
     Speed,
+    /// Wheel spin rate, stored in rad/s.
     AngularSpeed,
+    /// Angle (slip angle, inclination), stored in rad.
     Angle,
+    /// Force, stored in N.
     Force,
+    /// Moment, stored in N·m.
     Moment,
+    /// Inflation pressure, stored in Pa.
     Pressure,
+    /// Length (loaded and effective radii), stored in m.
     Length,
+    /// Temperature, stored in °C (the one non-SI unit kept).
     Temperature,
+    /// Dimensionless ratio (slip ratio κ), stored as a fraction (–); `%` is divided by 100.
     Ratio,
     /// Turn slip / curvature (1/m).
     InvLength,
@@ -43,7 +53,9 @@ impl Dim {
 /// Linear map to SI: `si = value * scale + offset`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ToSi {
+    /// Factor applied first (SI units per file unit).
     pub scale: f64,
+    /// Offset added after scaling, in the SI unit (non-zero for °F and K only).
     pub offset: f64,
 }
 

@@ -171,8 +171,10 @@ pub const TIME_CONFOUNDED_R: f64 = 0.9;
 /// A condition that varies beyond its noise, and with time in the run alone.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TimeDrift {
-    /// The 2nd and 98th percentiles of the condition over the segments' samples.
+    /// The 2nd percentile of the condition over the segments' samples
+    /// (the condition's unit: Pa for pressure).
     pub from: f64,
+    /// The 98th percentile, likewise.
     pub to: f64,
     /// Correlation of the segment means with the segments' mid-times.
     pub r: f64,

@@ -81,7 +81,9 @@ pub struct Residuals<'a> {
 /// Settings.
 #[derive(Clone, Copy, Debug)]
 pub struct LocateOptions {
+    /// Permutations (or circular shifts) N of each null distribution.
     pub permutations: usize,
+    /// Seed of the ChaCha8 random source (fixed: reproducible p-values).
     pub seed: u64,
     /// Family-wise false-alarm rate.
     pub alpha: f64,
@@ -111,6 +113,7 @@ pub struct Finding {
     pub p_value: f64,
     /// Holm-adjusted p-value.
     pub p_adjusted: f64,
+    /// Holm-adjusted p-value ≤ [`LocateOptions::alpha`]: structure, not noise.
     pub significant: bool,
     /// Plain-words detail (group means, hysteresis amplitude …).
     pub detail: String,

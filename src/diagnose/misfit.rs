@@ -43,6 +43,7 @@ pub fn excess_removed(gain: f64, ratio: f64) -> f64 {
 /// The baseline against the noise floor the data show, per channel.
 #[derive(Clone, Debug, Serialize)]
 pub struct BaselineFit {
+    /// The scored channel (written as its key, "FY").
     pub channel: Channel,
     /// RMS of the baseline's held-out residual, offset removed (N, N m).
     pub rms_residual: f64,

@@ -58,6 +58,7 @@ const BINS: usize = 30;
 pub struct Plot {
     /// File name inside the report directory.
     pub file: String,
+    /// Report key of the channel drawn ("FX", "FY", "MZ").
     pub channel: &'static str,
     /// What to look for, one sentence.
     pub caption: String,

@@ -83,16 +83,24 @@ fn speed_levels(rec: &Recording) -> Vec<(f64, Vec<usize>)> {
 /// One row of the quality table.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct QualityRow {
+    /// The scored channel (written as its key, "FY").
     pub channel: Channel,
     /// "all", "Fz 4000 N, γ 0.0°, p 220 kPa" or "Vx 58 km/h".
     pub condition: String,
     /// The condition's load (N) for a load/inclination/pressure condition;
     /// `None` for "all" and the per-speed rows.
     pub fz: Option<f64>,
+    /// Samples of the condition with a finite measured value.
     pub n: usize,
+    /// σ = √(Σ(sim − test)² / Σ test²) of the baseline (dimensionless;
+    /// its offset, estimated on the fit half, removed).
     pub sigma_before: f64,
+    /// The same of the verdict's extended model.
     pub sigma_after: f64,
+    /// NRMSE = RMS(sim − test) / (max test − min test) of the baseline
+    /// (dimensionless; offset removed likewise).
     pub nrmse_before: f64,
+    /// The same of the verdict's extended model.
     pub nrmse_after: f64,
 }
 
@@ -194,7 +202,9 @@ pub struct QualityReport {
     pub model_after: String,
     /// How the halves were formed, in words.
     pub split: &'static str,
+    /// Rows over the candidates' fit half.
     pub in_sample: Vec<QualityRow>,
+    /// Rows over the held-out half (segments the candidates never saw).
     pub out_of_sample: Vec<QualityRow>,
 }
 

@@ -157,9 +157,11 @@ pub struct Reestimated {
     pub fitted: Box<dyn Fitted>,
     /// Rounds kept (0: the plain refit).
     pub rounds: usize,
-    /// In-sample weighted error of the plain refit and of the result (NaN
-    /// when the replay behind them failed).
+    /// In-sample weighted error of the plain refit (dimensionless: each
+    /// channel's SSE over the baseline's mean square; NaN when the replay
+    /// behind it failed).
     pub cost_plain: f64,
+    /// The same of the result.
     pub cost: f64,
     /// Why the rounds stopped early on an error (the result is the best
     /// before it).
@@ -318,10 +320,17 @@ fn rounds(
 /// What [`beneath_rolling_radius`] returns: the tyre for `extended.tir`
 /// and the same account as [`Reestimated`].
 pub struct RadiusReestimated {
+    /// The tyre for `extended.tir`: the finding `ext`, or the MF re-estimated
+    /// beneath its radius keys when the round was kept.
     pub tyre: Tyre,
+    /// Rounds kept (0: the finding on the unchanged baseline).
     pub rounds: usize,
+    /// In-sample weighted error of the finding on the unchanged baseline
+    /// (dimensionless, as [`Reestimated::cost_plain`]; NaN when its replay failed).
     pub cost_plain: f64,
+    /// The same of the result.
     pub cost: f64,
+    /// Why the rounds stopped early on an error (the result is the best before it).
     pub failed: Option<String>,
 }
 

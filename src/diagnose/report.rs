@@ -13,8 +13,9 @@
 //! per condition (load, inclination, pressure; and per speed when the
 //! recording has more than one), on the segments the candidates were fitted
 //! on (`in_sample`) and on those they never saw (`out_of_sample`) — the
-//! split of [`super::candidate::split`]. These are the raw residuals (no
-//! offsets removed), as a user would compute them from `replay`.
+//! split of [`super::candidate::split`]. They are `replay`'s residuals less
+//! each model's constant channel offset (a sensor zero, estimated on the fit
+//! half only, as the candidates' scoring treats it).
 //!
 //! # Explanation
 //! The significant [`locate`] findings of each channel are put in words
@@ -88,20 +89,33 @@ pub fn locate_channel(
 /// One candidate in `diagnosis.json` ("effects", the verdict first).
 #[derive(Clone, Debug, Serialize)]
 pub struct EffectReport {
+    /// Candidate name as in [`crate::diagnose::candidate::all`] (`none`, `relaxation`, …).
     pub name: String,
     /// Pooled held-out gain ([`Evaluation::oos_gain`](crate::diagnose::candidate::Evaluation::oos_gain)).
     pub score: f64,
+    /// Pooled BIC change against the baseline over both halves
+    /// (dimensionless; negative = better), see [`crate::diagnose::candidate::evaluate`].
     pub delta_bic: f64,
+    /// Parameters fitted (those acting on a channel with data).
     pub n_params: usize,
     /// The evaluation in words: physics, fitted values, gains, why (not) named.
     pub evidence: String,
+    /// Per-channel held-out and fit-half gains and BIC changes (channels
+    /// with data only).
     pub channels: Vec<ChannelScore>,
+    /// Fitted parameters that ended at a bound of their range, in words
+    /// ("PPY3 = -3 (its lower bound)"): limits, not estimates.
     pub at_bound: Vec<String>,
     /// Fitted parameters by name (SI; NaN written as null).
     pub parameters: BTreeMap<String, f64>,
+    /// NRMSE (RMS(sim − test)/range(test), dimensionless) of the baseline
+    /// per channel over all samples.
     pub nrmse_before: NrmseMap,
+    /// The same of this candidate's fitted model (the baseline for `none`).
     pub nrmse_after: NrmseMap,
+    /// NRMSE of the baseline over the held-out samples only.
     pub nrmse_before_held_out: NrmseMap,
+    /// NRMSE of this candidate's fitted model over the held-out samples only.
     pub nrmse_after_held_out: NrmseMap,
 }
 
@@ -150,15 +164,23 @@ impl BaselineReestimated {
 /// `diagnosis.json`, typed.
 #[derive(Clone, Debug, Serialize)]
 pub struct DiagnosisReport {
+    /// The named effect: a candidate's name, `rolling_radius` when named
+    /// from the slip channel, or `none`.
     pub verdict: String,
+    /// The verdict, its evidence and its caveats in words.
     pub explanation: String,
     /// Other candidates that also qualify ([`also_qualifying`]), lowest
     /// BIC first: findings the data support besides the verdict.
     pub also_qualifying: Vec<String>,
+    /// Every candidate evaluated, the verdict first.
     pub effects: Vec<EffectReport>,
+    /// σ and NRMSE before and after the verdict, per channel and
+    /// condition, in sample and held out ([`QualityReport`]).
     pub quality: QualityReport,
     /// Findings per channel key ("FY").
     pub locate: BTreeMap<&'static str, Vec<Finding>>,
+    /// Names of every candidate the diagnosis weighs
+    /// ([`crate::diagnose::candidate::all`] order, `none` first).
     pub candidates_implemented: Vec<&'static str>,
     /// The baseline against the data's noise floor ([`baseline_fit`]).
     pub baseline_fit: Vec<BaselineFit>,
@@ -178,7 +200,9 @@ pub struct DiagnosisReport {
     /// ([`slip_channel::check`]); absent without an SR channel.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub slip_channel: Option<slip_channel::SlipChannel>,
+    /// Samples in the (merged) recording.
     pub samples: usize,
+    /// Test segments recognised in the recording.
     pub segments: usize,
     /// How the baseline was obtained (set by the command).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -218,9 +242,11 @@ pub struct Diagnosis {
     /// The verdict is the slip channel's rolling-radius finding
     /// ([`slip_channel`]), not a force candidate's.
     pub by_slip: bool,
+    /// The extended tyre written as `extended.tir` (the baseline for `none`).
     pub extended: Tyre,
-    /// Baseline and verdict's simulation, one per sample.
+    /// The baseline's simulation (ISO-W; N, N·m), one per sample.
     pub baseline_sim: Vec<Forces>,
+    /// The simulation of `extended` (what `extended.tir` does), one per sample.
     pub extended_sim: Vec<Forces>,
     /// Findings per channel (FY, FX, MZ where present).
     pub findings: Vec<(Channel, Vec<Finding>)>,

@@ -100,10 +100,13 @@ pub fn fit_gain(first: &[ChannelMetric], without: &[ChannelMetric], z: &SensorZe
 /// the reason in `not_estimated`).
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct SensorZeros {
+    /// Zero error of Fx (N; measured − true, subtracted from the recording).
     #[serde(rename = "Fx")]
     pub fx: Option<f64>,
+    /// Zero error of Fy (N; measured − true).
     #[serde(rename = "Fy")]
     pub fy: Option<f64>,
+    /// Zero error of Mz (N·m; measured − true).
     #[serde(rename = "Mz")]
     pub mz: Option<f64>,
     /// Channels without an estimate and why ("Fx: 2 load levels").

@@ -91,6 +91,7 @@ pub struct SlipChannel {
     /// The Fx sensor zero error fitted out of a drive/brake read (N; None
     /// on the lateral sweeps, which do not read Fx) ([`check`]).
     pub fx_zero: Option<f64>,
+    /// Free rolling per load level, lightest first (at least [`MIN_LEVELS`]).
     pub levels: Vec<Level>,
     /// Largest minus smallest level SR.
     pub sr_span: f64,

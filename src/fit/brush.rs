@@ -58,10 +58,15 @@ pub struct BrushFit {
     /// σ of Fy and Mz over the side-slip samples, σ of Fx over the
     /// longitudinal ones (NaN for an empty set).
     pub sigma_fy: f64,
+    /// Normalised residual σ of Mz over the side-slip samples
+    /// ([`sigma`]; NaN for an empty set).
     pub sigma_mz: f64,
+    /// Normalised residual σ of Fx over the longitudinal samples
+    /// ([`sigma`]; NaN for an empty set).
     pub sigma_fx: f64,
     /// Number of side-slip / longitudinal samples.
     pub n_lateral: usize,
+    /// Number of longitudinal-slip samples.
     pub n_longitudinal: usize,
     /// LM iterations.
     pub iterations: usize,

@@ -66,6 +66,8 @@ pub struct Geometry {
     /// Relative RMS and largest relative deviation of the fitted file's Re
     /// from the recorded Re on the free-rolling samples.
     pub re_rms: Option<f64>,
+    /// Largest relative deviation |Re_file − Re_rec| / Re_rec on the
+    /// free-rolling samples (`None` without such samples).
     pub re_max: Option<f64>,
     /// RMS deviation of the fitted file's Rl from the recorded Rl (m).
     pub rl_rms: Option<f64>,

@@ -22,17 +22,23 @@ use std::ops::Range;
 /// How to hold data out of a fit.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Holdout {
+    /// Nothing held out: the fit sees every segment.
     None,
     /// Every `every`-th segment.
     ByRun {
+        /// Period k (`run:K`, ≥ 2 when parsed): runs k, 2k, 3k … (1-based,
+        /// time order) are held out.
         every: usize,
     },
     /// Every `every`-th distinct test condition (all its segments).
     ByCondition {
+        /// Period k (`condition:K`, ≥ 2 when parsed) over the conditions
+        /// sorted by load, inclination, pressure.
         every: usize,
     },
     /// The last `frac` (0 < frac < 1) of the recording's time.
     Tail {
+        /// Held-out fraction of the recording's duration (0 < frac < 1).
         frac: f64,
     },
 }
@@ -40,7 +46,9 @@ pub enum Holdout {
 /// The two halves, as sample ranges in time order.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Split {
+    /// Sample ranges the fit sees (including samples outside every segment).
     pub train: Vec<Range<usize>>,
+    /// Sample ranges held out to judge the fit on.
     pub test: Vec<Range<usize>>,
 }
 

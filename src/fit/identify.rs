@@ -50,16 +50,19 @@ impl Default for IdentifyOptions {
 /// Verdict on one free parameter.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Verdict {
+    /// Determined by the data: fitted, with a standard error.
     Identified,
     /// The residuals do not depend on it.
     NoEffect,
     /// Its effect is a combination of these parameters' effects.
     Collinear {
+        /// Names of the identified parameters its column regresses on.
         with: Vec<String>,
     },
 }
 
 impl Verdict {
+    /// Whether the parameter is [`Verdict::Identified`].
     pub fn is_identified(&self) -> bool {
         matches!(self, Verdict::Identified)
     }

@@ -167,6 +167,7 @@ pub struct LmResult {
     /// Trial steps evaluated (by residuals, or by a linearisation at the
     /// trial point when the step is nearly undamped).
     pub residual_evals: usize,
+    /// Why the run stopped.
     pub termination: Termination,
     /// The last linearisation over the free columns, when it is at `theta`
     /// or one final step of predicted gain ≤ ftol·cost away from it (the
@@ -180,9 +181,13 @@ pub struct LmResult {
 /// matrix A = JᵀΩJ, gradient g = JᵀΩr, the cost and Σωr².
 #[derive(Clone, Debug)]
 pub struct Linearisation {
+    /// Parameter indices (θ order) of the linearised columns.
     pub cols: Vec<usize>,
+    /// Weighted Gram matrix A = JᵀΩJ over `cols` (symmetric, n×n).
     pub a: DMatrix<f64>,
+    /// Weighted gradient g = JᵀΩr over `cols`.
     pub g: DVector<f64>,
+    /// Cost ½Σ c²ρ(w r²/c²) at the linearisation point.
     pub cost: f64,
     /// Σ ωᵢ rᵢ² with the IRLS weights ω (= 2·cost for plain least squares).
     pub wrss: f64,

@@ -26,7 +26,10 @@ pub enum LossKind {
 /// regime (in residual units, e.g. newtons).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Loss {
+    /// Shape ρ of the loss.
     pub kind: LossKind,
+    /// Residual scale c (> 0, residual units); irrelevant for
+    /// [`LossKind::Linear`].
     pub scale: f64,
 }
 

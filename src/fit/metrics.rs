@@ -224,11 +224,15 @@ pub fn conditions(rec: &Recording) -> Vec<Condition> {
 /// Metrics of one channel over one set of samples.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ChannelMetric {
+    /// Channel name (`Fx`, `Fy`, `Mz` …).
     pub channel: String,
     /// `None` for the row over all samples.
     pub condition: Option<Condition>,
+    /// Samples with a finite measured value.
     pub n: usize,
+    /// Normalised residual √(Σ(sim − test)² / Σ test²) ([`sigma`]), dimensionless.
     pub sigma: f64,
+    /// RMS error over the measured range, max − min ([`nrmse`]), dimensionless.
     pub nrmse: f64,
     /// RMS error in the channel's SI unit.
     pub rms: f64,

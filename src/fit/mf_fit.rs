@@ -36,6 +36,7 @@ pub struct MfFitOptions {
     /// Then fit the relaxation lengths ([`super::transient`]; replays, so
     /// off by default).
     pub transient: bool,
+    /// Which samples to hold out of the fit and judge it on (`--holdout`).
     pub holdout: Holdout,
     /// Per recording (same order): the time its first row was recorded,
     /// before a warm-up cut — the origin of `--holdout tail:F`'s time
@@ -61,7 +62,12 @@ pub struct MfFitOptions {
     /// shifted Fx would pick other samples and another Re(Fz). `None`: the
     /// fitted ones.
     pub geometry_recordings: Option<std::sync::Arc<Vec<Recording>>>,
+    /// Threads the residuals and Jacobians are evaluated on (results do not
+    /// depend on it); default: the available parallelism.
     pub threads: usize,
+    /// Settings of every stage's fit (LM, swarm, identifiability, holds);
+    /// the default uses the staged tolerances [`STAGED_FTOL`],
+    /// [`STAGED_DCHI2`], [`STAGED_STALL`] and a coarse-first polish.
     pub fit: FitOptions,
     /// Minimum samples for a stage to run.
     pub min_samples: usize,
@@ -135,7 +141,9 @@ pub type TrainTest = (Vec<Range<usize>>, Vec<Range<usize>>);
 
 /// Result of [`fit_mf`].
 pub struct MfFit {
+    /// The fitted tyre property file (start file with the fitted keys set).
     pub tyre: TyreParams,
+    /// Per-stage outcomes and figures, as written to `fit.json`.
     pub report: FitReport,
     /// Stages skipped and why.
     pub skipped: Vec<String>,

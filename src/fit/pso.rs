@@ -18,11 +18,18 @@ use rand_chacha::ChaCha8Rng;
 /// Swarm settings.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct PsoOptions {
+    /// Swarm size (at least 1 is used).
     pub particles: usize,
+    /// Maximum number of swarm iterations (each evaluates every particle once).
     pub iterations: usize,
+    /// Seed of the ChaCha8 generator: the same seed gives the same result
+    /// on every run and machine.
     pub seed: u64,
+    /// Velocity weight χ (Clerc–Kennedy constriction: 0.7298).
     pub inertia: f64,
+    /// Acceleration towards the particle's own best (χ·c₁: 1.49618).
     pub cognitive: f64,
+    /// Acceleration towards the swarm's best (χ·c₂: 1.49618).
     pub social: f64,
     /// Largest velocity component, as a fraction of the box width.
     pub vmax_fraction: f64,
@@ -53,12 +60,17 @@ impl Default for PsoOptions {
 /// Best point found.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PsoResult {
+    /// Best point (the swarm's global best), in the box.
     pub x: Vec<f64>,
     /// The particles' personal bests with a finite cost, best first, without
     /// duplicates (`candidates[0] == x` unless no point had a finite cost).
     pub candidates: Vec<Vec<f64>>,
+    /// Cost at `x` (+∞ if no point had a finite cost).
     pub cost: f64,
+    /// Number of cost evaluations, the initial swarm's included.
     pub evaluations: usize,
+    /// Iterations run (fewer than [`PsoOptions::iterations`] when
+    /// `patience` stopped the swarm).
     pub iterations: usize,
 }
 

@@ -14,9 +14,13 @@ use super::pso::{self, PsoOptions};
 /// Settings of one fit.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct FitOptions {
+    /// Levenberg–Marquardt polish: iteration limit, tolerances, initial
+    /// damping, robust loss and stop rules.
     pub lm: LmOptions,
     /// Global start by particle swarm (needs finite bounds on the free parameters).
     pub pso: Option<PsoOptions>,
+    /// Thresholds of the identifiability test that decides which free
+    /// parameters are held at their start values.
     pub identify: IdentifyOptions,
     /// With a subsampled problem given to [`fit_global`]: converge the LM on
     /// it first (to a loose tolerance, 1e-6), then polish on all samples.
@@ -54,20 +58,27 @@ impl FitOptions {
 /// What is happening, for a progress display.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Phase {
+    /// Global search by particle swarm ([`pso::minimize`]).
     Swarm,
+    /// Bounded Levenberg–Marquardt polish of one start ([`lm`]).
     Polish,
 }
 
 /// One progress report.
 #[derive(Clone, Copy, Debug)]
 pub struct Progress<'a> {
+    /// Name of the stage being fitted (e.g. `"pure Fy"`).
     pub stage: &'a str,
+    /// Swarm or polish.
     pub phase: Phase,
-    /// Iteration within the phase, and its upper limit.
+    /// Iteration within the phase.
     pub iteration: usize,
+    /// Upper limit of `iteration`: [`PsoOptions::iterations`] or
+    /// [`LmOptions::max_iter`].
     pub max_iterations: usize,
-    /// Which start is being polished (0-based), of how many (1 without a swarm).
+    /// Which start is being polished (0-based).
     pub candidate: usize,
+    /// Number of starts polished (1 without a swarm).
     pub candidates: usize,
     /// Best cost so far (within this phase and candidate).
     pub cost: f64,
@@ -87,17 +98,26 @@ pub enum ParamStatus {
     /// Fitted, but ended on a bound (its standard error is only indicative).
     AtBound,
     /// Free, but the data cannot determine it: held at its start value.
-    NotIdentified { reason: Verdict },
+    NotIdentified {
+        /// Why: no effect on the residuals, or collinear with named parameters.
+        reason: Verdict,
+    },
 }
 
 /// One parameter's result.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ParamResult {
+    /// Parameter name (the `.tir` key in lower case for Magic Formula fits,
+    /// e.g. `pdy1`).
     pub name: String,
+    /// Value the fit started from (given start, or carried from an earlier
+    /// stage), in the parameter's own unit.
     pub start: f64,
+    /// Fitted value; equal to `start` unless fitted.
     pub value: f64,
     /// Standard error (identified parameters only).
     pub stderr: Option<f64>,
+    /// How the parameter came out (fixed, fitted, at a bound, not identified).
     #[serde(flatten)]
     pub status: ParamStatus,
 }
@@ -105,21 +125,30 @@ pub struct ParamResult {
 /// Result of one fit.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct FitOutcome {
+    /// Name of the stage (the `stage` argument of [`fit`]).
     pub stage: String,
     /// All parameter values (θ order of the problem).
     pub theta: Vec<f64>,
+    /// Per-parameter results, θ order.
     pub params: Vec<ParamResult>,
+    /// Cost ½Σ c²ρ(w r²/c²) ([`super::loss::Loss::cost`]) at the start,
+    /// on all residuals.
     pub initial_cost: f64,
     /// Best swarm cost, if a swarm ran.
     pub swarm_cost: Option<f64>,
+    /// Cost at the solution, on all residuals (same definition as
+    /// `initial_cost`).
     pub cost: f64,
     /// Residual variance s² = Σωr²/(m − n_identified).
     pub residual_variance: f64,
     /// Pairs of fitted parameters whose estimates correlate beyond ±0.95
     /// (name, name, correlation): the data mainly determine a combination.
     pub correlated: Vec<(String, String, f64)>,
+    /// Number of residuals m of the full problem.
     pub n_residuals: usize,
+    /// LM outer iterations of the chosen start's final (full-data) polish.
     pub iterations: usize,
+    /// Why that polish stopped.
     pub termination: Termination,
 }
 
@@ -596,11 +625,13 @@ fn polish(
 
 /// One stage of a staged fit.
 pub struct Stage<'a> {
+    /// Stage name, for progress and the report.
     pub name: String,
     /// The stage's problem (its own data subset and residual channels).
     pub problem: &'a dyn Problem,
     /// Names of the parameters this stage fits; empty = the problem's `free` flags.
     pub free: Vec<String>,
+    /// Settings of this stage's fit.
     pub options: FitOptions,
     /// Problem the swarm runs on (a subsample of `problem`); `None` = `problem`.
     pub swarm_problem: Option<&'a dyn Problem>,
@@ -611,9 +642,11 @@ pub struct Stage<'a> {
 pub struct ParamValues(pub Vec<(String, f64)>);
 
 impl ParamValues {
+    /// The value carried for `name` (exact match), if any.
     pub fn get(&self, name: &str) -> Option<f64> {
         self.0.iter().find(|(n, _)| n == name).map(|(_, v)| *v)
     }
+    /// Set the value of `name`, appending it if it is new.
     pub fn set(&mut self, name: &str, value: f64) {
         match self.0.iter_mut().find(|(n, _)| n == name) {
             Some(e) => e.1 = value,

@@ -61,20 +61,29 @@ pub struct RelaxationFit {
     pub channel: String,
     /// The `.tir` key fitted.
     pub key: String,
+    /// Start value of `key`, SI (N/m for LATERAL_STIFFNESS /
+    /// LONGITUDINAL_STIFFNESS, dimensionless for PTY1 / PTX1).
     pub start: f64,
     /// Value written (the start value when not identified).
     pub value: f64,
     /// Relaxation length at FNOMIN, zero slip, NOMPRES and LONGVL (m): at
     /// the start and as fitted.
     pub sigma_start: f64,
+    /// Relaxation length as fitted (m), at the same conditions.
     pub sigma: f64,
-    /// Σ(sim − measured)² over the fitted samples: steady model, start, fit.
+    /// Σ(sim − measured)² over the fitted samples (N²) with the steady
+    /// model (no lag), for comparison.
     pub cost_steady: f64,
+    /// Σ(sim − measured)² (N²) with the relaxation model at the start value.
     pub cost_start: f64,
+    /// Σ(sim − measured)² (N²) with the relaxation model at `value`.
     pub cost: f64,
+    /// Number of samples the cost sums over.
     pub samples: usize,
     /// Replays run.
     pub evaluations: usize,
+    /// Whether the recording resolves a lag (gain ≥ [`MIN_GAIN`], not on the
+    /// short end of the search); if not, `value` is the start.
     pub identified: bool,
     /// Why not identified (empty when identified).
     pub note: String,

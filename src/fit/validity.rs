@@ -38,8 +38,11 @@ pub const MU_MIN: f64 = 0.05;
 /// pressures (Pa; empty: the file's NOMPRES).
 #[derive(Clone, Debug, Default)]
 pub struct Grid {
+    /// Normal loads (N).
     pub fz: Vec<f64>,
+    /// Inclination angles (rad).
     pub gamma: Vec<f64>,
+    /// Inflation pressures (Pa); empty: the file's NOMPRES only.
     pub p: Vec<f64>,
 }
 

@@ -125,16 +125,22 @@ unsafe fn guarded(
     }
 }
 
+/// FMI 2.0 §2.1.4: the platform types of the headers the binary was built with,
+/// always "default" (fmi2TypesPlatform.h). Refuses nothing.
 #[no_mangle]
 pub extern "C" fn fmi2GetTypesPlatform() -> *const c_char {
     c"default".as_ptr()
 }
 
+/// FMI 2.0 §2.1.4: the FMI version of the headers, always "2.0". Refuses nothing.
 #[no_mangle]
 pub extern "C" fn fmi2GetVersion() -> *const c_char {
     c"2.0".as_ptr()
 }
 
+/// FMI 2.0 §2.1.5: switch debug logging, or the named log categories, on or
+/// off (see [`Logger::set_debug_logging`]). Allowed in every state; refuses an
+/// unknown category name or a NULL/non-UTF-8 list entry, and then changes nothing.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetDebugLogging(
     c: fmi2Component,
@@ -153,6 +159,10 @@ pub unsafe extern "C" fn fmi2SetDebugLogging(
     })
 }
 
+/// FMI 2.0 §2.1.5: create an instance and load the packaged resources/tyre.tir.
+/// Returns NULL, the reason logged, for an empty instanceName, an `fmuType` other
+/// than fmi2CoSimulation, a GUID not this binary's, a missing or unusable
+/// fmuResourceLocation and an unusable tyre file. `visible` is ignored.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2Instantiate(
     instance_name: fmi2String,
@@ -219,6 +229,8 @@ pub unsafe extern "C" fn fmi2Instantiate(
     r.unwrap_or(std::ptr::null_mut())
 }
 
+/// FMI 2.0 §2.1.5: free the instance and every FMU state it created that the
+/// master did not free. NULL or a pointer that is not a live instance is ignored.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
     let _ = catch_unwind(AssertUnwindSafe(|| {
@@ -239,6 +251,10 @@ pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
     }));
 }
 
+/// FMI 2.0 §2.1.6: set startTime (s, the first communication point) and
+/// stopTime (s). `tolerance` is ignored (fixed-step model); only in the instantiated
+/// state; refuses a non-finite startTime and a stopTime that is non-finite or
+/// below startTime. stopTime is recorded, not enforced.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetupExperiment(
     c: fmi2Component,
@@ -254,6 +270,8 @@ pub unsafe extern "C" fn fmi2SetupExperiment(
     })
 }
 
+/// FMI 2.0 §2.1.6: enter initialization mode (start values and parameters
+/// may still be set). Only in the instantiated state.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2EnterInitializationMode(c: fmi2Component) -> Fmi2Status {
     guarded(
@@ -268,6 +286,9 @@ pub unsafe extern "C" fn fmi2EnterInitializationMode(c: fmi2Component) -> Fmi2St
     )
 }
 
+/// FMI 2.0 §2.1.6: leave initialization mode for stepComplete after computing
+/// the initial outputs. If the model refuses the parameters or inputs, answers
+/// fmi2Error and enters the error state.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> Fmi2Status {
     guarded(c, "fmi2ExitInitializationMode", allowed::INIT, |inst| {
@@ -276,6 +297,8 @@ pub unsafe extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> Fmi2Sta
     })
 }
 
+/// FMI 2.0 §2.1.6: end the simulation (terminated state; values remain
+/// readable). Only in stepComplete.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2Terminate(c: fmi2Component) -> Fmi2Status {
     guarded(c, "fmi2Terminate", allowed::STEP, |inst| {
@@ -285,6 +308,8 @@ pub unsafe extern "C" fn fmi2Terminate(c: fmi2Component) -> Fmi2Status {
     })
 }
 
+/// FMI 2.0 §2.1.6: back to the state right after fmi2Instantiate (start values,
+/// the packaged tyre). Refused only in the fatal state.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2Reset(c: fmi2Component) -> Fmi2Status {
     guarded(c, "fmi2Reset", allowed::ALL_LIVE, |inst| {
@@ -293,6 +318,9 @@ pub unsafe extern "C" fn fmi2Reset(c: fmi2Component) -> Fmi2Status {
     })
 }
 
+/// FMI 2.0 §2.1.7: read Real variables (SI units as the XML declares them). In
+/// initialization mode the outputs are computed first. Refuses an unknown or
+/// non-Real value reference and a NULL array with `nvr > 0`.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetReal(
     c: fmi2Component,
@@ -306,6 +334,8 @@ pub unsafe extern "C" fn fmi2GetReal(
     })
 }
 
+/// FMI 2.0 §2.1.7: read Integer variables (`use_mode`). Refuses an unknown or
+/// non-Integer value reference and a NULL array with `nvr > 0`.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetInteger(
     c: fmi2Component,
@@ -319,6 +349,9 @@ pub unsafe extern "C" fn fmi2GetInteger(
     })
 }
 
+/// FMI 2.0 §2.1.7: read Boolean variables (`contact`, `nonlinear`,
+/// `mirrored`). Refuses an unknown or non-Boolean value reference and a NULL
+/// array with `nvr > 0`.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetBoolean(
     c: fmi2Component,
@@ -332,6 +365,9 @@ pub unsafe extern "C" fn fmi2GetBoolean(
     })
 }
 
+/// FMI 2.0 §2.1.7: read String variables; the pointers stay valid until the
+/// next call on this instance. Refuses an unknown or non-String value reference and
+/// a NULL array with `nvr > 0`.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetString(
     c: fmi2Component,
@@ -345,6 +381,10 @@ pub unsafe extern "C" fn fmi2GetString(
     })
 }
 
+/// FMI 2.0 §2.1.7: write Real inputs (SI units); every value is checked before
+/// any is stored. Refuses unknown or non-Real value references, outputs and
+/// calculated parameters, non-finite values, values outside the XML's min/max and
+/// a pressure `p` in (0, [`P_MIN`](super::instance::P_MIN)) Pa.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetReal(
     c: fmi2Component,
@@ -358,6 +398,10 @@ pub unsafe extern "C" fn fmi2SetReal(
     })
 }
 
+/// FMI 2.0 §2.1.7: write Integer parameters (`use_mode`), validated as they are
+/// set. Refuses unknown or non-Integer value references, outputs and calculated
+/// parameters, fixed parameters after initialization and invalid values (value
+/// not taken).
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetInteger(
     c: fmi2Component,
@@ -371,6 +415,9 @@ pub unsafe extern "C" fn fmi2SetInteger(
     })
 }
 
+/// FMI 2.0 §2.1.7: write Boolean parameters (`nonlinear`). Refuses unknown or
+/// non-Boolean value references, outputs (`contact`) and calculated parameters
+/// (`mirrored`), and fixed parameters after initialization.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetBoolean(
     c: fmi2Component,
@@ -384,6 +431,11 @@ pub unsafe extern "C" fn fmi2SetBoolean(
     })
 }
 
+/// FMI 2.0 §2.1.7: write String parameters (`tyre_file` loads the file;
+/// `input_mode`, `transient`, `side`, `force_model` are validated as set). Refuses
+/// unknown or non-String value references, fixed parameters after initialization,
+/// NULL or non-UTF-8 text, invalid values and unloadable tyre files (value not
+/// taken).
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetString(
     c: fmi2Component,
@@ -413,6 +465,9 @@ unsafe fn snapshot_ref<'a>(s: fmi2FMUstate) -> Result<&'a Snapshot, String> {
     Ok(snap)
 }
 
+/// FMI 2.0 §2.1.8: copy the instance's complete state into a new FMU state
+/// (`*state` NULL) or into the given one. Refused in the fatal state, for a NULL
+/// `state` pointer and for a `*state` that is not a live FMU state.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetFMUstate(c: fmi2Component, state: *mut fmi2FMUstate) -> Fmi2Status {
     guarded(c, "fmi2GetFMUstate", allowed::ALL_LIVE, |inst| {
@@ -437,6 +492,9 @@ pub unsafe extern "C" fn fmi2GetFMUstate(c: fmi2Component, state: *mut fmi2FMUst
     })
 }
 
+/// FMI 2.0 §2.1.8: restore the instance to a saved FMU state. Refused in the
+/// fatal state, for NULL or a pointer that is not a live FMU state, and for a
+/// state inconsistent with its own parameters.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, state: fmi2FMUstate) -> Fmi2Status {
     guarded(c, "fmi2SetFMUstate", allowed::ALL_LIVE, |inst| {
@@ -447,6 +505,8 @@ pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, state: fmi2FMUstate) 
     })
 }
 
+/// FMI 2.0 §2.1.8: free an FMU state and set `*state` to NULL (NULL is a no-op).
+/// Refuses a state created by another instance.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2FreeFMUstate(
     c: fmi2Component,
@@ -470,6 +530,8 @@ pub unsafe extern "C" fn fmi2FreeFMUstate(
     })
 }
 
+/// FMI 2.0 §2.1.8: the number of bytes fmi2SerializeFMUstate will write for
+/// this state. Refuses a NULL or non-live state and a NULL `size` pointer.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
     c: fmi2Component,
@@ -491,6 +553,9 @@ pub unsafe extern "C" fn fmi2SerializedFMUstateSize(
     )
 }
 
+/// FMI 2.0 §2.1.8: write the state as bytes (format: [`super::snapshot`]).
+/// Refuses a non-live state and a buffer smaller than
+/// fmi2SerializedFMUstateSize.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SerializeFMUstate(
     c: fmi2Component,
@@ -513,6 +578,10 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(
     })
 }
 
+/// FMI 2.0 §2.1.8: rebuild an FMU state from bytes of fmi2SerializeFMUstate.
+/// Refuses a NULL `state` pointer, a buffer that fails any check (magic, version,
+/// length, GUID, checksum, values) and one saved with a tyre other than the
+/// instance's current or packaged one; never opens a file.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     c: fmi2Component,
@@ -542,6 +611,8 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     })
 }
 
+/// FMI 2.0 §2.1.9: partial derivatives of outputs with respect to inputs.
+/// Always refused (`providesDirectionalDerivative = false`).
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
     c: fmi2Component,
@@ -557,6 +628,8 @@ pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
     })
 }
 
+/// FMI 2.0 §4.2.1: time derivatives of inputs for interpolation over a step.
+/// Always refused (`canInterpolateInputs = false`: inputs are held constant).
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
     c: fmi2Component,
@@ -573,6 +646,8 @@ pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
     })
 }
 
+/// FMI 2.0 §4.2.1: time derivatives of outputs at the communication point.
+/// Always refused (`maxOutputDerivativeOrder = 0`).
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
     c: fmi2Component,
@@ -589,6 +664,11 @@ pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
     )
 }
 
+/// FMI 2.0 §4.2.2: advance by `communicationStepSize` (s) with the inputs held
+/// constant, synchronously (never fmi2Pending). Only in stepComplete; refuses a
+/// step size that is not finite and > 0, a `currentCommunicationPoint` other than
+/// the FMU's time, out-of-range inputs, Fz above
+/// [`fz_limit`](super::instance::fz_limit) and a model failure, changing nothing.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2DoStep(
     c: fmi2Component,
@@ -602,6 +682,8 @@ pub unsafe extern "C" fn fmi2DoStep(
     })
 }
 
+/// FMI 2.0 §4.2.2: cancel an asynchronous step. Refused in every state: steps
+/// are synchronous, so none is ever in progress.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2CancelStep(c: fmi2Component) -> Fmi2Status {
     // Steps are synchronous: there is never a step in progress to cancel.
@@ -619,6 +701,9 @@ fn not_available(inst: &Instance, what: &str, kind: fmi2StatusKind) -> Result<Fm
     Ok(Fmi2Status::Discard)
 }
 
+/// FMI 2.0 §4.2.3: the fmi2Status of an asynchronous step (fmi2DoStepStatus).
+/// Answers fmi2Discard with a warning for every kind (steps are synchronous);
+/// refuses a NULL `value`.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetStatus(
     c: fmi2Component,
@@ -633,6 +718,8 @@ pub unsafe extern "C" fn fmi2GetStatus(
     })
 }
 
+/// FMI 2.0 §4.2.3: for fmi2LastSuccessfulTime, the time (s) the FMU last
+/// stepped to; fmi2Discard with a warning for other kinds; refuses a NULL `value`.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetRealStatus(
     c: fmi2Component,
@@ -651,6 +738,8 @@ pub unsafe extern "C" fn fmi2GetRealStatus(
     })
 }
 
+/// FMI 2.0 §4.2.3: an Integer status; none is defined, so fmi2Discard with a
+/// warning for every kind; refuses a NULL `value`.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetIntegerStatus(
     c: fmi2Component,
@@ -665,6 +754,9 @@ pub unsafe extern "C" fn fmi2GetIntegerStatus(
     })
 }
 
+/// FMI 2.0 §4.2.3: for fmi2Terminated, always fmi2False (the FMU never ends a
+/// simulation by itself); fmi2Discard with a warning for other kinds; refuses a
+/// NULL `value`.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetBooleanStatus(
     c: fmi2Component,
@@ -684,6 +776,9 @@ pub unsafe extern "C" fn fmi2GetBooleanStatus(
     })
 }
 
+/// FMI 2.0 §4.2.3: the fmi2PendingStatus text of an asynchronous step;
+/// fmi2Discard with a warning for every kind (steps are synchronous); refuses a
+/// NULL `value`.
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetStringStatus(
     c: fmi2Component,

@@ -46,14 +46,24 @@ pub const INSTANCE_TAG: u64 = 0x5459_5245_4b49_5431; // "TYREKIT1"
 /// Name of the packaged tyre property file inside `resources/`.
 pub const RESOURCE_TIR: &str = "tyre.tir";
 
-/// FMI 2.0 co-simulation states.
+/// FMI 2.0 co-simulation states (§4.2.4). The standard's `stepInProgress`,
+/// `stepFailed` and `stepCanceled` never occur: steps are synchronous and a
+/// refused step changes nothing.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Phase {
+    /// After fmi2Instantiate or fmi2Reset: parameters and start values may be
+    /// set, fmi2SetupExperiment called.
     Instantiated,
+    /// Between fmi2EnterInitializationMode and fmi2ExitInitializationMode.
     InitializationMode,
+    /// Initialized and ready for fmi2DoStep (also after every successful step).
     StepComplete,
+    /// After fmi2Terminate: values stay readable, no more steps.
     Terminated,
+    /// fmi2ExitInitializationMode failed: no consistent configuration; values
+    /// stay readable, fmi2Reset or fmi2SetFMUstate starts over.
     Error,
+    /// A panic was caught: only fmi2FreeInstance remains useful.
     Fatal,
 }
 
@@ -94,16 +104,28 @@ pub mod allowed {
     const fn m(p: super::Phase) -> u8 {
         1 << (p as u8)
     }
+    /// Every state but `Fatal` (fmi2Reset and the FMU-state functions).
     pub const ALL_LIVE: u8 =
         m(Instantiated) | m(InitializationMode) | m(StepComplete) | m(Terminated) | m(Error);
+    /// Every state, `Fatal` included (fmi2SetDebugLogging).
     pub const ANY: u8 = ALL_LIVE | m(Fatal);
+    /// `Instantiated` only (fmi2SetupExperiment, fmi2EnterInitializationMode).
     pub const INSTANTIATED: u8 = m(Instantiated);
+    /// `InitializationMode` only (fmi2ExitInitializationMode).
     pub const INIT: u8 = m(InitializationMode);
+    /// `StepComplete` only (fmi2DoStep, fmi2Terminate).
     pub const STEP: u8 = m(StepComplete);
+    /// Where values can be read (fmi2GetReal & co., fmi2GetDirectionalDerivative).
     pub const GET: u8 = m(InitializationMode) | m(StepComplete) | m(Terminated) | m(Error);
+    /// Where values can be written (fmi2SetReal & co.,
+    /// fmi2SetRealInputDerivatives); which variables, per state, is checked
+    /// per variable.
     pub const SET: u8 = m(Instantiated) | m(InitializationMode) | m(StepComplete);
+    /// Where the slave's status can be inquired (fmi2GetStatus & co., §4.2.3).
     pub const STATUS: u8 = m(StepComplete) | m(Terminated) | m(Error);
+    /// Where fmi2GetRealOutputDerivatives may be called.
     pub const OUTPUT_DERIVATIVES: u8 = m(StepComplete) | m(Terminated) | m(Error);
+    /// No state (fmi2CancelStep: there is never a step in progress to cancel).
     pub const NONE: u8 = 0;
 }
 
@@ -120,6 +142,7 @@ pub fn phases_in(mask: u8) -> String {
 /// A loaded tyre and the `tyre_file` value it was loaded for.
 #[derive(Clone, Debug)]
 pub struct Loaded {
+    /// The checked tyre model, shared with the FMU states that use it.
     pub tyre: Arc<Tyre>,
     /// The `tyre_file` parameter value ("" = the packaged resources/tyre.tir).
     pub key: String,
@@ -133,25 +156,35 @@ pub struct Loaded {
 /// Everything an FMU state captures (fmi2GetFMUstate clones this).
 #[derive(Clone, Debug)]
 pub struct Sim {
+    /// The FMI state.
     pub phase: Phase,
+    /// Current communication point (s): the time the next fmi2DoStep must start at.
     pub time: f64,
+    /// `startTime` of fmi2SetupExperiment (s; 0 until it is called).
     pub start_time: f64,
+    /// `stopTime` of fmi2SetupExperiment (s), if the master defined one.
     pub stop_time: Option<f64>,
+    /// Current value of every variable (inputs, outputs, parameters).
     pub values: Values,
+    /// The transient tyre model: its configuration, options and dynamic state.
     pub model: TransientModel,
     /// Evaluate the mirror image of the file's tyre (see the module header).
     pub mirror: bool,
+    /// The tyre in use (the current `tyre_file`).
     pub loaded: Loaded,
 }
 
 /// One FMU instance (what fmi2Component points to).
 pub struct Instance {
+    /// [`INSTANCE_TAG`] while the instance lives; 0 once fmi2FreeInstance ran.
     pub tag: u64,
+    /// The master's logger with this instance's category filter.
     pub log: Logger,
     /// The FMU's resources folder (from fmuResourceLocation).
     pub resources: PathBuf,
     /// resources/tyre.tir, loaded at instantiation (what fmi2Reset returns to).
     pub default_tyre: Loaded,
+    /// The simulation: state, values, model (what an FMU state copies).
     pub sim: Sim,
     /// The start values `tyrekit package` chose for this FMU (read from the
     /// packaged modelDescription.xml at instantiation; `fmi::start`).
@@ -167,10 +200,14 @@ pub type ChosenStart = (&'static str, String);
 /// The settings derived from the parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Derived {
+    /// Transient model, input mode and use mode (parameters `transient`,
+    /// `input_mode`, `use_mode`).
     pub config: TransientConfig,
     /// Non-linear relaxation (parameter `nonlinear`) and the LuGre parameters
     /// of the tyre file's `[LUGRE]` section (defaults without one).
     pub options: TransientOptions,
+    /// Evaluate the mirror image of the file's tyre: parameter `side` names
+    /// the side opposite the file's TYRESIDE (see the module header).
     pub mirror: bool,
 }
 

@@ -18,10 +18,16 @@ use std::ffi::CString;
 /// Log categories, in the order of [`CATEGORY_NAMES`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Category {
+    /// `logEvents`: state changes (initialization, termination, reset, FMU state
+    /// restored) and fmi2OK/fmi2Pending messages; debug logging only.
     Events = 0,
+    /// `logStatusWarning`: messages sent with fmi2Warning or fmi2Discard; on by default.
     StatusWarning = 1,
+    /// `logStatusError`: why a call answered fmi2Error; on by default.
     StatusError = 2,
+    /// `logStatusFatal`: why a call answered fmi2Fatal; on by default.
     StatusFatal = 3,
+    /// `logAll`: a trace line for every FMI call; debug logging only.
     All = 4,
 }
 

@@ -40,7 +40,9 @@ pub const SNAPSHOT_TAG: u64 = 0x5459_5245_5354_4154; // "TYRESTAT"
 /// What an fmi2FMUstate points to.
 #[derive(Clone, Debug)]
 pub struct Snapshot {
+    /// [`SNAPSHOT_TAG`] while the state lives; 0 once it is freed.
     pub tag: u64,
+    /// The saved simulation (phase, time, values, model state, tyre).
     pub sim: Sim,
     /// The instance that created it (only it may free it; fmi2FreeInstance
     /// frees every state its instance still owns).

@@ -6,12 +6,17 @@
 
 use std::ffi::CString;
 
-/// FMI base type of a variable.
+/// FMI base type of a variable (the child element of `<ScalarVariable>`,
+/// FMI 2.0 §2.2.7).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum VarType {
+    /// `<Real>`: an `fmi2Real` (f64), read/written by fmi2GetReal/fmi2SetReal.
     Real,
+    /// `<Integer>`: an `fmi2Integer` (i32).
     Integer,
+    /// `<Boolean>`: an `fmi2Boolean` (stored as `bool`).
     Boolean,
+    /// `<String>`: an `fmi2String` (stored NUL-terminated).
     String,
 }
 
@@ -27,51 +32,75 @@ impl VarType {
     }
 }
 
-/// FMI causality (only those the interface uses).
+/// FMI causality (FMI 2.0 §2.2.7; only those the interface uses).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Causality {
+    /// `input`: set by the master before each step (wheel motion, load, pressure, …).
     Input,
+    /// `output`: computed by the step (forces, moments, slips, …).
     Output,
+    /// `parameter`: set by the master before initialization (tyre file, modes).
     Parameter,
+    /// `calculatedParameter`: computed from the parameters and the tyre file
+    /// (e.g. its unloaded radius and nominal load).
     CalculatedParameter,
 }
 
-/// FMI variability.
+/// FMI variability (FMI 2.0 §2.2.7): when a variable's value may change.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Variability {
+    /// `constant`: never changes.
     Constant,
+    /// `fixed`: fixed after initialization (fmi2ExitInitializationMode).
     Fixed,
+    /// `tunable`: may change between communication points, set by the master.
     Tunable,
+    /// `discrete`: changes only at communication points.
     Discrete,
+    /// `continuous`: a Real that may change continuously in time.
     Continuous,
 }
 
 /// Start value from the XML.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Start {
+    /// No `start` attribute (calculated variables start at 0 / false / "").
     None,
+    /// `start` of a Real, in the variable's unit (SI).
     Real(f64),
+    /// `start` of an Integer.
     Integer(i32),
+    /// `start` of a Boolean.
     Boolean(bool),
+    /// `start` of a String.
     String(&'static str),
 }
 
 /// One row of the generated variable table.
 #[derive(Clone, Copy, Debug)]
 pub struct VarInfo {
+    /// `valueReference`: the number the master passes to fmi2Get*/fmi2Set*.
     pub vr: u32,
+    /// `name` (e.g. `Fz`, `tyre_file`).
     pub name: &'static str,
+    /// Base type: which storage array and getter/setter it belongs to.
     pub ty: VarType,
     /// Index into the storage array of its type.
     pub slot: usize,
+    /// `causality`.
     pub causality: Causality,
+    /// `variability`.
     pub variability: Variability,
+    /// `start` value.
     pub start: Start,
+    /// `unit` of a Real as the XML writes it (SI: "N", "N.m", "m/s", "rad", "1";
+    /// "" when none).
     pub unit: &'static str,
     /// Hard lower limit of a Real (`min` of the XML; −inf when none).
     pub min: f64,
     /// Hard upper limit of a Real (`max` of the XML; +inf when none).
     pub max: f64,
+    /// `description`: one line for the master's user.
     pub description: &'static str,
 }
 
@@ -92,8 +121,11 @@ pub fn by_name(name: &str) -> Option<&'static VarInfo> {
 /// Typed storage of every variable's current value.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Values {
+    /// Real values by slot ([`real`]), SI units.
     pub reals: [f64; real::N],
+    /// Integer values by slot ([`integer`]).
     pub integers: [i32; integer::N],
+    /// Boolean values by slot ([`boolean`]).
     pub booleans: [bool; boolean::N],
     /// NUL-terminated so that fmi2GetString can hand out pointers into them.
     pub strings: [CString; string::N],

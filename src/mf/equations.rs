@@ -35,10 +35,19 @@ pub enum Form {
 /// Forces, moments and the by-products the outputs need, in scalar type `T`.
 #[derive(Clone, Copy, Debug)]
 pub struct Solution<T> {
+    /// Longitudinal force Fx (N, ISO-W), combined slip: Gxα·Fx0 (4.E50).
     pub fx: T,
+    /// Lateral force Fy (N, ISO-W), combined slip: Gyκ·Fy0 + SVyκ (4.E58).
     pub fy: T,
+    /// Overturning moment Mx (N·m, ISO-W): the MF 6.1 form with QSX1–QSX14
+    /// that MFeval uses (extends 4.E69).
     pub mx: T,
+    /// Rolling resistance moment My (N·m, ISO-W, opposing rolling): paper
+    /// eq. A48 for MF 6.x, the 4.E70 / MF-Tyre 5.2 form otherwise; NaN when
+    /// not requested.
     pub my: T,
+    /// Aligning moment Mz (N·m, ISO-W), combined slip: −t·Fy′ + Mzr + s·Fx
+    /// (4.E71, 4.E72).
     pub mz: T,
     /// Longitudinal friction coefficient (4.E13).
     pub mux: T,

@@ -133,10 +133,17 @@ pub struct MfInput {
 /// Forces and moments only (the hot-path result), ISO-W, SI.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Forces {
+    /// Longitudinal force Fx (N), positive driving the wheel forward
+    /// (Pacejka, *Tyre and Vehicle Dynamics*, 3rd ed., eq. 4.E50).
     pub fx: f64,
+    /// Lateral force Fy (N), ISO-W +y (eq. 4.E58).
     pub fy: f64,
+    /// Overturning moment Mx (N·m) about ISO-W +x (MF 6.1 form of eq. 4.E69).
     pub mx: f64,
+    /// Rolling resistance moment My (N·m) about ISO-W +y, negative when
+    /// rolling forward (MF 6.x paper eq. A48; eq. 4.E70 for MF 5.2).
     pub my: f64,
+    /// Aligning moment Mz (N·m) about ISO-W +z (eq. 4.E71).
     pub mz: f64,
 }
 
@@ -149,37 +156,66 @@ pub const OUTPUT_COLUMNS: [&str; 30] = [
 
 /// All outputs of one evaluation, in MFeval's order ([`OUTPUT_COLUMNS`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-#[allow(missing_docs)]
 pub struct MfOutput {
+    /// Longitudinal force Fx (N, ISO-W: positive driving).
     pub fx: f64,
+    /// Lateral force Fy (N, ISO-W).
     pub fy: f64,
+    /// Vertical load Fz (N, positive in compression).
     pub fz: f64,
+    /// Overturning moment Mx (N·m, ISO-W).
     pub mx: f64,
+    /// Rolling resistance moment My (N·m, ISO-W).
     pub my: f64,
+    /// Self-aligning moment Mz (N·m, ISO-W).
     pub mz: f64,
+    /// Longitudinal slip κ used by the equations (–, after the use mode's limits).
     pub kappa: f64,
+    /// Slip angle α used by the equations (rad, ISO-W).
     pub alpha: f64,
+    /// Inclination γ used by the equations (rad).
     pub gamma: f64,
+    /// Turn slip φt (1/m).
     pub phit: f64,
+    /// Longitudinal speed of the wheel centre Vcx (m/s).
     pub vx: f64,
+    /// Inflation pressure (Pa).
     pub p: f64,
+    /// Effective rolling radius Re (m).
     pub re: f64,
+    /// Vertical deflection ρ (m).
     pub rho: f64,
+    /// Contact patch length 2a (m).
     pub a2: f64,
+    /// Pneumatic trail t (m).
     pub t: f64,
+    /// Longitudinal friction coefficient μx (–; Pacejka eq. 4.E13).
     pub mux: f64,
+    /// Lateral friction coefficient μy (–, as computed; Pacejka eq. 4.E23).
     pub muy: f64,
+    /// Wheel spin rate Ω (rad/s).
     pub omega: f64,
+    /// Loaded radius Rl (m).
     pub rl: f64,
+    /// Contact patch width 2b (m).
     pub b2: f64,
+    /// Residual aligning moment Mzr (N·m), the part of Mz not from the trail (Pacejka eq. 4.E75 for combined slip).
     pub mzr: f64,
+    /// Longitudinal carcass stiffness Cx (N/m).
     pub cx: f64,
+    /// Lateral carcass stiffness Cy (N/m).
     pub cy: f64,
+    /// Vertical stiffness Cz (N/m).
     pub cz: f64,
+    /// Cornering stiffness Kyα at the current load (N/rad; Pacejka eq. 4.E25).
     pub kya: f64,
+    /// Longitudinal relaxation length σκ = Kxκ/Cx (m).
     pub sigmax: f64,
+    /// Lateral relaxation length σα = Kyα/Cy (m).
     pub sigmay: f64,
+    /// Instantaneous cornering stiffness ∂Fy/∂α at the operating point (N/rad).
     pub inst_kya: f64,
+    /// Longitudinal slip stiffness Kxκ (N per unit slip; Pacejka eq. 4.E15).
     pub kxk: f64,
 }
 

@@ -14,11 +14,18 @@ use crate::mf::{Forces, Real, Solution};
 /// A force or moment channel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Channel {
+    /// Longitudinal force Fx (N, along the ISO-W x axis: positive forward, as when driving).
     Fx,
+    /// Lateral force Fy (N, along the ISO-W y axis: positive to the left).
     Fy,
+    /// Vertical load Fz (N, positive pressing the tyre on the road): the
+    /// model's input, never simulated.
     Fz,
+    /// Overturning moment Mx (N·m, about the ISO-W x axis).
     Mx,
+    /// Rolling resistance moment My (N·m, about the ISO-W y axis).
     My,
+    /// Self-aligning moment Mz (N·m, about the ISO-W z axis, up).
     Mz,
 }
 

@@ -55,8 +55,11 @@ use std::io::Write;
 /// How to replay.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ReplayOptions {
+    /// Transient model stepped through the recording (default: steady-state MF).
     pub kind: TransientKind,
+    /// MFeval-style use mode: limit checks, α* definition, turn slip.
     pub use_mode: UseMode,
+    /// Relaxation variant and LuGre parameters of the transient model.
     pub options: TransientOptions,
     /// A step longer than this many median spacings is a gap (reset).
     pub gap_factor: f64,
@@ -84,6 +87,7 @@ impl Default for ReplayOptions {
 /// could not be replayed) and the runs between resets.
 #[derive(Clone, Debug, Default)]
 pub struct Replay {
+    /// Simulated forces and moments (ISO-W; N, N·m), one per sample.
     pub sim: Vec<Forces>,
     /// Full step outputs (slips used, μ, slip speeds …), one per sample.
     pub out: Vec<WheelOutput>,

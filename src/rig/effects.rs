@@ -78,14 +78,19 @@ fn nominal(t: &Tyre) -> (f64, f64) {
 /// form). Signature: Fy lags behind α — hysteresis between rising and falling
 /// sweeps, growing with slip rate / speed.
 pub struct Relaxation {
+    /// The steady MF the lagged slips are fed to.
     pub inner: SteadyMf,
+    /// Relaxation length σκ of the slip ratio (m of rolled distance).
     pub sigma_x: f64,
+    /// Relaxation length σα of tan α (m of rolled distance).
     pub sigma_y: f64,
     kappa: f64,
     tan_alpha: f64,
 }
 
 impl Relaxation {
+    /// Relaxation truth over `tyre` with lengths σκ = `sigma_x`, σα =
+    /// `sigma_y` (m); the lagged slips start at zero.
     pub fn new(tyre: Tyre, sigma_x: f64, sigma_y: f64) -> Self {
         Relaxation {
             inner: SteadyMf::new(tyre),
@@ -128,11 +133,16 @@ impl TruthModel for Relaxation {
 /// bristles lag like those relaxation lengths; a tyre file's own carcass
 /// stiffness can give metres), so level 2 has twice the lag at small slip.
 pub struct LuGre {
+    /// The steady MF supplying the radii (and the model's tyre).
     pub inner: SteadyMf,
+    /// The LuGre transient model, fed the rig's prescribed slips
+    /// ([`InputMode::Slips`]).
     pub model: TransientModel,
 }
 
 impl LuGre {
+    /// LuGre truth over `tyre` at strength `level` (bristle stiffnesses
+    /// σ0x, σ0y from the slip stiffnesses as in the type docs).
     pub fn new(tyre: Tyre, level: f64) -> Self {
         let (fnom, _) = nominal(&tyre);
         let o = tyre.slip_properties(
@@ -225,6 +235,7 @@ impl TruthModel for LuGre {
 /// temperature correlated with them. The temperature is what the rig writes
 /// to its tread-temperature channels.
 pub struct Thermal {
+    /// The steady MF whose friction the temperature scales.
     pub inner: SteadyMf,
     /// Heat capacity of the tread layer (J/K).
     pub capacity: f64,
@@ -238,6 +249,7 @@ pub struct Thermal {
     pub k: f64,
     /// The temperature–friction curve.
     pub curve: ThermalCurve,
+    /// Ambient temperature Tamb (°C); the tread starts at it after [`TruthModel::reset`].
     pub ambient: f64,
     temp: f64,
     last_power: f64,
@@ -324,7 +336,9 @@ impl TruthModel for Thermal {
 /// A static scaling effect: friction scale `s` and stiffness scale `c`
 /// computed from the imposed inputs, with an optional slip shift.
 pub struct Scaling {
+    /// The steady MF being scaled.
     pub inner: SteadyMf,
+    /// Which static effect.
     pub kind: ScalingKind,
     /// Strength (meaning per kind, see [`ScalingKind`]).
     pub strength: f64,
@@ -367,6 +381,8 @@ pub enum ScalingKind {
 }
 
 impl Scaling {
+    /// Static effect `kind` of `strength` over `tyre` (nominal load and
+    /// pressure from the tyre file, else 4000 N and 200 kPa).
     pub fn new(tyre: Tyre, kind: ScalingKind, strength: f64) -> Self {
         let (fnom, pnom) = nominal(&tyre);
         Scaling {

@@ -41,6 +41,8 @@ pub struct RigInput {
 /// What the truth model returns (ISO-W, SI).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TruthOutput {
+    /// Forces and moments at the contact point (ISO-W; N, N·m). The normal
+    /// load is imposed by the rig ([`RigInput::mf`]), so it is not returned.
     pub forces: Forces,
     /// Effective rolling radius (m) — sets Ω for a given κ.
     pub re: f64,
@@ -91,7 +93,9 @@ pub trait TruthModel {
 /// The plain steady-state Magic Formula as a truth model.
 #[derive(Clone, Debug)]
 pub struct SteadyMf {
+    /// The Magic Formula tyre evaluated at every sample.
     pub tyre: Tyre,
+    /// Use mode passed to `Tyre::evaluate` ([`SteadyMf::new`]: no limits, α* off, no turn slip).
     pub mode: UseMode,
 }
 
@@ -140,7 +144,9 @@ impl TruthModel for SteadyMf {
 /// `points` at `rate` (rad/s), at the programme's first set point.
 #[derive(Clone, Debug)]
 pub struct Warmup {
+    /// Turning points of the slip-angle sweep (ISO-W α, rad), run from and back to 0.
     pub points: Vec<f64>,
+    /// Slip-angle sweep rate (rad/s).
     pub rate: f64,
     /// Load of the warm-up (N); None: the programme's first load (the
     /// warm-up then runs straight into the first segment at the same set point).
@@ -166,8 +172,9 @@ pub struct Programme {
     pub db_alphas: Vec<f64>,
     /// Inclinations of the drive/brake runs (rad).
     pub db_inclinations: Vec<f64>,
-    /// Slip-ratio sweep amplitude and rate (1/s): 0 → +A → −A → 0.
+    /// Slip-ratio sweep amplitude A (–): 0 → +A → −A → 0.
     pub db_kappa: f64,
+    /// Slip-ratio sweep rate (1/s).
     pub kappa_rate: f64,
     /// Time to move between set points (s), at zero slip.
     pub transition: f64,
@@ -216,23 +223,38 @@ impl Programme {
 /// Sensor noise (1σ) and constant offsets, in ISO-W SI.
 #[derive(Clone, Debug)]
 pub struct Noise {
+    /// Fx noise (N, 1σ).
     pub fx: f64,
+    /// Fy noise (N, 1σ).
     pub fy: f64,
+    /// Fz noise on the recorded load (N, 1σ); see `fz_wander` for the true load.
     pub fz: f64,
+    /// Mx noise (N·m, 1σ).
     pub mx: f64,
+    /// Mz noise (N·m, 1σ).
     pub mz: f64,
+    /// Slip-angle noise (rad, 1σ).
     pub alpha: f64,
+    /// Inclination noise (rad, 1σ).
     pub gamma: f64,
+    /// Inflation-pressure noise (Pa, 1σ).
     pub p: f64,
+    /// Belt-speed noise (m/s, 1σ).
     pub v: f64,
+    /// Wheel-spin noise (rad/s, 1σ); also enters the recorded RE = V/Ω.
     pub omega: f64,
+    /// Loaded-radius (RL) noise (m, 1σ).
     pub radius: f64,
     /// Load-control wander of the true load (N, 1σ, slowly varying).
     pub fz_wander: f64,
-    /// Offsets added to the recorded values (not to the truth).
+    /// Constant Fy offset (N) added to the recorded values (offsets never
+    /// reach the truth).
     pub fy_offset: f64,
+    /// Constant Fx offset (N) added to the recorded values.
     pub fx_offset: f64,
+    /// Constant Mz offset (N·m) added to the recorded values.
     pub mz_offset: f64,
+    /// Constant slip-angle offset (ISO-W, rad) added to the recorded values.
     pub alpha_offset: f64,
 }
 
@@ -295,13 +317,17 @@ pub enum TtcUnits {
 /// Rig configuration.
 #[derive(Clone, Debug)]
 pub struct RigConfig {
+    /// The test programme to run.
     pub programme: Programme,
     /// Simulation rate (Hz).
     pub sample_rate: f64,
     /// Record every n-th simulated sample (1 = all).
     pub decimate: usize,
+    /// Sensor noise and offsets of the recorded channels.
     pub noise: Noise,
+    /// Seed of the ChaCha8 random source of the noise: equal seeds give identical runs.
     pub seed: u64,
+    /// Which TTC export layout (SI or US customary) the table is written in.
     pub units: TtcUnits,
     /// Ambient temperature (°C).
     pub ambient: f64,

@@ -77,10 +77,17 @@ pub enum MfVersion {
 /// Which side of the vehicle the file's coefficients were measured for (TYRESIDE).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub enum TyreSide {
+    /// `LEFT` (also the default when the file gives no TYRESIDE): the
+    /// coefficients describe a tyre on the left of the vehicle.
     #[default]
     Left,
+    /// `RIGHT`: the coefficients describe a right-hand tyre; the FMU
+    /// mirrors it about the wheel's x-z plane when asked for the left.
     Right,
+    /// `SYMMETRIC`: the coefficients hold for either side, never mirrored.
     Symmetric,
+    /// `UNKNOWN`, or a value that was not recognised; counts as LEFT
+    /// (MF-Tyre's default).
     Unknown,
 }
 

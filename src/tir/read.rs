@@ -37,12 +37,21 @@ pub const LEGACY_SPELLINGS: [(&str, &str); 10] = [
 
 /// Everything [`read`] produces.
 pub struct ReadOut {
+    /// Equation set detected from FITTYP / PROPERTY_FILE_FORMAT.
     pub version: MfVersion,
+    /// Numeric parameters converted to SI through `[UNITS]`, defaults filled in.
     pub p: MfParams,
+    /// TYRESIDE of the file ([`TyreSide::Left`] when absent).
     pub side: TyreSide,
+    /// Names of the table keys the file did not give validly (defaults used).
     pub defaulted: Vec<&'static str>,
+    /// Table keys given with an empty or non-numeric value, with their line
+    /// (1-based); read as not given.
     pub invalid: Vec<(&'static str, usize)>,
+    /// Reader warnings with line numbers (duplicates, odd values …), capped.
     pub warnings: Vec<String>,
+    /// Everything that is not a table key (strings, tables, unknown keys
+    /// and sections), kept for the writer.
     pub doc: TirDoc,
 }
 

@@ -18,11 +18,20 @@ const INCH: f64 = 0.0254;
 /// The kind of quantity a `[UNITS]` key names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum UnitKind {
+    /// `LENGTH`: radii, deflections, widths (SI: m).
     Length,
+    /// `FORCE`: loads and force scalings such as FNOMIN, FZMIN (SI: N).
     Force,
+    /// `ANGLE`: slip and inclination limits ALPMIN…CAMMAX, angular
+    /// stiffnesses (SI: rad).
     Angle,
+    /// `MASS`: tyre, belt and rim masses and inertias (SI: kg).
     Mass,
+    /// `TIME`: integration settings (HMAX_LOCAL, TIME_SWITCH_INTEG) and the
+    /// time part of speeds, damping, frequencies (SI: s).
     Time,
+    /// `PRESSURE`: INFLPRES, NOMPRES, pressure limits (SI: Pa); not an
+    /// ADAMS key, honoured when present.
     Pressure,
 }
 
@@ -160,10 +169,15 @@ impl UnitKind {
 /// `mm`/`newton` file).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Units {
+    /// Metres per file `LENGTH` unit.
     pub length: f64,
+    /// Newtons per file `FORCE` unit.
     pub force: f64,
+    /// Radians per file `ANGLE` unit.
     pub angle: f64,
+    /// Kilograms per file `MASS` unit.
     pub mass: f64,
+    /// Seconds per file `TIME` unit.
     pub time: f64,
     /// `None`: derived from force / length².
     pub pressure: Option<f64>,

@@ -386,6 +386,7 @@ pub struct Extension {
     pub lmuv: Option<(f64, f64)>,
     /// The law of [`SPEED_SECTION`].
     pub speed: Option<SpeedLaw>,
+    /// The lumped tread-temperature model of [`THERMAL_SECTION`].
     pub thermal: Option<Thermal>,
     /// Nominal load Fz0 = FNOMIN·LFZO (N).
     pub fz0: f64,

@@ -81,12 +81,17 @@ pub enum LuGreFriction {
 /// LuGre parameters. Zero σ's mean "derive from the tyre" (see module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LuGreParams {
+    /// Friction function g the bristles saturate at (MF-derived or Stribeck).
     pub friction: LuGreFriction,
-    /// Bristle stiffness per unit normal load (1/m), longitudinal / lateral; 0 = C/Fz.
+    /// Longitudinal bristle stiffness σ0x per unit normal load (1/m): the
+    /// LuGre σ0 (Canudas de Wit et al. 1995) divided by Fz; 0 = Cx/Fz.
     pub sigma0x: f64,
+    /// Lateral bristle stiffness σ0y per unit normal load (1/m); 0 = Cy/Fz.
     pub sigma0y: f64,
-    /// Bristle damping per unit normal load (s/m); 0 = low-speed damping c/Fz.
+    /// Longitudinal bristle damping σ1x per unit normal load (s/m); 0 = the
+    /// relaxation model's low-speed damping cx/Fz.
     pub sigma1x: f64,
+    /// Lateral bristle damping σ1y per unit normal load (s/m); 0 = cy/Fz.
     pub sigma1y: f64,
     /// Viscous friction per unit normal load (s/m).
     pub sigma2: f64,

@@ -179,10 +179,16 @@ pub struct WheelInput {
 /// One step's outputs, ISO-W, SI (the FMU's output variables).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct WheelOutput {
+    /// Longitudinal force Fx (N), positive forward (driving).
     pub fx: f64,
+    /// Lateral force Fy (N), positive towards +y (left).
     pub fy: f64,
+    /// Overturning moment Mx (N·m).
     pub mx: f64,
+    /// Rolling-resistance moment My (N·m); for the transient models the MF's
+    /// My at zero slip and the actual speed.
     pub my: f64,
+    /// Self-aligning moment Mz (N·m).
     pub mz: f64,
     /// Longitudinal slip the force model used.
     pub kappa: f64,
@@ -190,7 +196,11 @@ pub struct WheelOutput {
     pub alpha: f64,
     /// Effective rolling radius (m).
     pub re: f64,
+    /// Longitudinal friction coefficient μx (–) at zero slip (Pacejka 3rd ed.
+    /// eq. 4.E13), times the friction scale `s`.
     pub mux: f64,
+    /// Lateral friction coefficient μy (–) at zero slip (Pacejka 3rd ed.
+    /// eq. 4.E23), times the friction scale `s`.
     pub muy: f64,
     /// Longitudinal slip speed of the contact point (m/s).
     pub vsx: f64,
@@ -228,8 +238,12 @@ pub struct TransientState {
 /// Settings of a transient model.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TransientConfig {
+    /// Which dynamics: steady, relaxation or LuGre.
     pub kind: TransientKind,
+    /// Whether slips come from the velocities or are prescribed.
     pub input_mode: InputMode,
+    /// Magic Formula use mode (`.tir` range limits, α*, turn slip) of every force
+    /// evaluation.
     pub use_mode: UseMode,
 }
 
@@ -253,7 +267,10 @@ pub struct TransientOptions {
 /// A tyre's dynamics: configuration plus state. One per FMU instance / replay.
 #[derive(Clone, Debug, Default)]
 pub struct TransientModel {
+    /// Model kind, input mode and MF use mode.
     pub config: TransientConfig,
+    /// The dynamic state (deflections or bristles, see the module docs); all
+    /// zero at rest.
     pub state: TransientState,
     /// Variant and LuGre parameters (not part of the state: set once at instantiation).
     pub options: TransientOptions,

@@ -15,34 +15,52 @@ use crate::tir::MfVersion;
 pub struct TyreProps {
     /// Effective rolling radius (m).
     pub re: f64,
-    /// Longitudinal / lateral carcass stiffness (N/m).
+    /// Longitudinal carcass stiffness Cx (N/m): the MF's (MF 6.1/6.2,
+    /// PCFX*), else LONGITUDINAL_STIFFNESS of the file.
     pub cx: f64,
+    /// Lateral carcass stiffness Cy (N/m): the MF's (MF 6.1/6.2, PCFY*),
+    /// else LATERAL_STIFFNESS of the file.
     pub cy: f64,
-    /// Longitudinal / lateral relaxation length at zero slip (m).
+    /// Longitudinal relaxation length σκ at zero slip (m), = Kxκ/Cx
+    /// (Pacejka 3rd ed. §7.2) or the file's MF 5.2 PTX form; clamped to
+    /// [`SIGMA_MIN`]..[`SIGMA_MAX`].
     pub sigma_x: f64,
+    /// Lateral relaxation length σα at zero slip (m), = Kyα/Cy (Pacejka
+    /// 3rd ed. §7.2) or the file's MF 5.2 PTY form; clamped likewise.
     pub sigma_y: f64,
-    /// Low-speed damping coefficients (N s/m), already weighted by the
-    /// speed blend (zero above VXLOW).
+    /// Longitudinal low-speed damping (N·s/m), already weighted by the
+    /// speed blend `weight` (zero from VXLOW up).
     pub damp_x: f64,
+    /// Lateral low-speed damping (N·s/m), weighted like `damp_x`.
     pub damp_y: f64,
     /// Low-speed blend w(|Vx|) (1 at rest, 0 from VXLOW up).
     pub weight: f64,
-    /// Deflections friction can hold, μ·Fz/C (m), longitudinal / lateral
-    /// (infinite when the MF gives no μ); before the friction scale.
+    /// Longitudinal deflection friction can hold, μx·Fz/Cx (m); infinite
+    /// when the MF gives no μ; before the friction scale.
     pub ux_max: f64,
+    /// Lateral deflection friction can hold, μy·Fz/Cy (m); as `ux_max`.
     pub uy_max: f64,
-    /// Unweighted damping coefficients (N s/m) (LuGre σ1 default).
+    /// Unweighted longitudinal damping (N·s/m),
+    /// `DAMP_VLOW·Cx + 2·DAMP_LONG·√(Cx·BELT_MASS)` (LuGre σ1 default).
     pub damp_x_full: f64,
+    /// Unweighted lateral damping (N·s/m),
+    /// `DAMP_VLOW·Cy + 2·DAMP_LAT·√(Cy·BELT_MASS)` (LuGre σ1 default).
     pub damp_y_full: f64,
-    /// Friction coefficients (MF's μx, μy; slip-independent), before the friction scale.
+    /// The MF's longitudinal friction coefficient μx (–, slip-independent,
+    /// Pacejka 3rd ed. eq. 4.E13), before the friction scale.
     pub mux: f64,
+    /// The MF's lateral friction coefficient μy (–, slip-independent,
+    /// Pacejka 3rd ed. eq. 4.E23), before the friction scale.
     pub muy: f64,
-    /// MF forces at zero slip (N), at the actual speed (0 if not finite, or
-    /// not computed: the step's probe skips them where they are not used).
+    /// MF longitudinal force Fx at zero slip (N) at the actual speed (0 if
+    /// not finite, or not computed: the step's probe skips it where unused).
     pub fx0: f64,
+    /// MF lateral force Fy at zero slip (N), as `fx0` (shifts, camber thrust).
     pub fy0: f64,
-    /// Slip stiffnesses at zero slip, Kxκ (N) and Kyα (N/rad), from the MF.
+    /// Longitudinal slip stiffness Kxκ at zero slip (N per unit κ), from the MF.
     pub kxk: f64,
+    /// Cornering stiffness Kyα at zero slip (N/rad), from the MF, with its
+    /// sign (negative in ISO-W for the usual negative PKY1).
     pub kya: f64,
 }
 

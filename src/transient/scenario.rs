@@ -22,7 +22,13 @@ pub enum BrakeControl {
     Locked,
     /// Hold the slip at `target` (magnitude, e.g. 0.15) above `min_speed`;
     /// below it brake with the full torque (ABS switches off near standstill).
-    SlipControl { target: f64, min_speed: f64 },
+    SlipControl {
+        /// Braking slip to hold, (V − Ω·Re)/V (–, positive).
+        target: f64,
+        /// Vehicle speed (m/s) below which the controller hands over to the
+        /// full torque.
+        min_speed: f64,
+    },
 }
 
 /// A quarter-vehicle braking run.
@@ -44,8 +50,9 @@ pub struct BrakingScenario {
     pub dt: f64,
     /// Give up after this long (s).
     pub t_max: f64,
-    /// Transient model and options.
+    /// Transient model run at the wheel.
     pub kind: TransientKind,
+    /// Options of that model (relaxation variant, LuGre parameters, brush).
     pub options: TransientOptions,
 }
 

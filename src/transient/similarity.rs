@@ -116,8 +116,11 @@ fn similar_input(base: &MfInput, slip: Slip, s: f64) -> MfInput {
 /// A slip point: κ, tan α and α (kept together so α = atan(tan α) is computed once).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Slip {
+    /// Longitudinal slip ratio κ (–), positive when driving.
     pub kappa: f64,
+    /// Tangent of the slip angle, tan α (–; ISO-W sign).
     pub tan_alpha: f64,
+    /// Slip angle α = atan(tan α) (rad).
     pub alpha: f64,
 }
 

@@ -176,7 +176,11 @@ pub enum Reestimation {
 
 /// A candidate extension.
 pub trait Candidate: Send + Sync {
+    /// Name in the report and the CLI (`relaxation`, `pressure`, …; the
+    /// table of the module docs).
     fn name(&self) -> &'static str;
+    /// Parameters the candidate has (0 for `none`), before any is held for
+    /// lack of data.
     fn n_params(&self) -> usize;
     /// The physics in one line, as a tyre engineer would say it
     /// ("transient slip lag"): used in the explanation of a verdict.

@@ -207,12 +207,21 @@ pub enum Target {
 /// nothing.
 #[derive(Clone, Debug)]
 pub struct Param {
+    /// Name in the report (usually the tyre-file key, e.g. "PPY3").
     pub name: &'static str,
+    /// Where the value is written; every target gets the same value.
     pub targets: Vec<Target>,
+    /// Start value (usually the file's), also the value held when backward
+    /// elimination drops the parameter; in the key's own unit.
     pub init: f64,
+    /// Lower bound of the fitted range (same unit as `init`).
     pub lo: f64,
+    /// Upper bound of the fitted range (same unit as `init`).
     pub hi: f64,
+    /// Forward-difference step of the Jacobian, also the parameter's
+    /// natural scale (same unit as `init`).
     pub h: f64,
+    /// Scored channels it acts on (indices into [`Channel::SCORED`]).
     pub channels: &'static [usize],
     /// The lower bound is a physical value the parameter may take (VREF =
     /// 0: the file's friction is the one at zero sliding speed), not a
@@ -243,6 +252,8 @@ pub type FromData = fn(&Recording, &[bool]) -> Option<Vec<(Target, f64)>>;
 /// How a parametrised candidate applies to one baseline tyre.
 #[derive(Clone, Debug, Default)]
 pub struct Spec {
+    /// Parameters to fit; those acting on no channel with data in the fit
+    /// half stay at their `init`.
     pub params: Vec<Param>,
     /// Values written as they are (not fitted).
     pub fixed: Vec<(Target, f64)>,
@@ -608,10 +619,16 @@ fn eliminate(
 /// [`Spec`] (built per baseline tyre; None: not applicable to that tyre, the
 /// fit is then the baseline itself).
 pub struct ParamCandidate {
+    /// See [`Candidate::name`].
     pub name: &'static str,
+    /// See [`Candidate::physics`].
     pub physics: &'static str,
+    /// Parameters the candidate has ([`Candidate::n_params`]).
     pub n: usize,
+    /// Builds the [`Spec`] for a baseline tyre (None: not applicable to it).
     pub spec: fn(&Tyre, &ReplayOptions) -> Option<Spec>,
+    /// The fitted extension in words ([`Candidate::describe`], before the
+    /// note on held parameters).
     pub words: fn(&dyn Fitted) -> String,
     /// See [`Candidate::reestimation`].
     pub reestimation: Reestimation,

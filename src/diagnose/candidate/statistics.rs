@@ -20,6 +20,7 @@ use crate::residual::{
 /// own squared error (offsets removed) against the baseline's.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct ChannelScore {
+    /// The scored channel (Fx, Fy or Mz; written as its key, "FY").
     pub channel: Channel,
     /// Held-out samples of the channel.
     pub n: usize,
@@ -48,6 +49,7 @@ pub struct ChannelScore {
 /// A candidate's evaluation.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Evaluation {
+    /// Candidate name ([`Candidate::name`]).
     pub name: String,
     /// Parameters fitted (those acting on a channel with data).
     pub n_params: usize,
@@ -62,6 +64,7 @@ pub struct Evaluation {
     pub delta_bic: f64,
     /// Per-channel gains (channels with data only).
     pub channels: Vec<ChannelScore>,
+    /// Fitted parameters by name, in the tyre file's units (SI) ([`Fitted::parameters`]).
     pub parameters: Vec<(String, f64)>,
     /// Fitted parameters that ended at a bound ([`Fitted::at_bound`]).
     pub at_bound: Vec<String>,

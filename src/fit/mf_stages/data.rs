@@ -16,16 +16,22 @@ use std::ops::Range;
 /// Spread of the fitted data below which camber (pressure) terms are held:
 /// 0.5° (5 kPa), well below any test plan's steps.
 pub const CAMBER_SPREAD: f64 = 0.5 * std::f64::consts::PI / 180.0;
+/// Spread of inflation pressure below which pressure terms (PP*) are held:
+/// 5 kPa, in Pa.
 pub const PRESSURE_SPREAD: f64 = 5000.0;
 
 /// Conditioned inputs and measured values of the samples one stage fits.
 #[derive(Clone, Debug, Default)]
 pub struct StageData {
+    /// Inputs of each sample as conditioned in [`USE_MODE`] (limits applied),
+    /// ISO-W, SI.
     pub conds: Vec<Conditions>,
     /// Measured channel per sample, one vector per channel of the stage.
     pub meas: Vec<Vec<f64>>,
-    /// Spread (max − min) of inclination and pressure over the samples.
+    /// Spread of inclination over the samples (rad), between its 1st and
+    /// 99th percentiles (a few stray samples do not widen it).
     pub gamma_spread: f64,
+    /// Spread of inflation pressure over the samples (Pa), likewise.
     pub p_spread: f64,
     /// The range the MF's validity conditions must hold on
     /// ([`crate::fit::validity`]); `None`: no validity rows.

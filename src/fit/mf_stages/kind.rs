@@ -11,9 +11,19 @@ use crate::data::SegmentKind;
 /// Which fit stage.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StageKind {
+    /// Pure longitudinal force Fx0 (PCX1, PDX*, PEX*, PKX*, PHX*, PVX*,
+    /// PPX*; Pacejka, *Tyre and Vehicle Dynamics*, 3rd ed., eqs.
+    /// 4.E9–4.E18) over the pure longitudinal segments.
     PureFx,
+    /// Pure lateral force Fy0 (PCY1, PDY*, PEY*, PKY*, PHY*, PVY*, PPY*;
+    /// eqs. 4.E19–4.E30) over the pure lateral segments.
     PureFy,
+    /// Pure aligning moment Mz0 (QBZ*, QCZ1, QDZ*, QEZ*, QHZ*, PPZ*; eqs.
+    /// 4.E31–4.E49) over the pure lateral segments.
     Mz,
+    /// Combined slip: the weightings Gxα, Gyκ and SVyκ (RBX*, RCX1, REX*,
+    /// RHX1, RBY*, RCY1, REY*, RHY*, RVY*; eqs. 4.E50–4.E67) and the Mz
+    /// arm s (SSZ*, eq. 4.E76) over the combined segments, Fx, Fy and Mz.
     Combined,
     /// Overturning moment (QSX*) over the pure lateral segments.
     Mx,

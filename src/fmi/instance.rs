@@ -933,19 +933,25 @@ impl Instance {
         Ok(())
     }
 
-    /// fmi2SetBoolean (no Boolean is settable today; the checks still name why).
+    /// fmi2SetBoolean: every reference is checked before any value is stored,
+    /// and the values are taken back if the configuration they give is refused
+    /// (as fmi2SetInteger and fmi2SetString do).
     pub fn set_boolean(&mut self, vrs: &[u32], vals: &[i32]) -> Result<(), String> {
         for vr in vrs {
             let v = var(*vr, VarType::Boolean)?;
             self.check_settable(v)?;
         }
+        let old = self.sim.values.booleans;
         for (vr, x) in vrs.iter().zip(vals) {
             if let Some(v) = vars::lookup(*vr) {
                 self.sim.values.booleans[v.slot] = *x != 0;
             }
         }
         // A Boolean parameter (nonlinear) changes the derived options.
-        self.reconfigure()
+        self.reconfigure().map_err(|e| {
+            self.sim.values.booleans = old;
+            format!("{e}; values not taken")
+        })
     }
 
     /// fmi2GetString: pointers into the instance, valid until the next call.

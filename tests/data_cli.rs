@@ -1,5 +1,6 @@
 //! `tyrekit data summary | convert | plot` end to end on a rig recording.
 
+use crate::common::scratch;
 use std::process::Command;
 use tyrekit::mf::Tyre;
 use tyrekit::rig::{simulate, RigConfig, SteadyMf};
@@ -18,8 +19,8 @@ fn tyrekit(args: &[&str]) -> (bool, String, String) {
 
 #[test]
 fn summary_convert_plot() {
-    let d = std::env::temp_dir().join(format!("tyrekit-data-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
+    let tmp = scratch("data-cli");
+    let d = tmp.path();
     let tyre = Tyre::builtin();
     let mut cfg = RigConfig::standard(&tyre, 4);
     cfg.decimate = 4;
@@ -93,5 +94,4 @@ fn summary_convert_plot() {
     assert!(!ok && err.contains("expected csv or tdx"));
     let (ok, _, err) = tyrekit(&["data", "summary", dat_s, "--axes", "nasa"]);
     assert!(!ok && err.contains("--axes"));
-    let _ = std::fs::remove_dir_all(&d);
 }

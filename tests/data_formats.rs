@@ -3,22 +3,22 @@
 //! counted, missing channels reported, and malformed or truncated files
 //! rejected with an error naming the file and the place.
 
-use std::path::PathBuf;
+use crate::common::scratch;
+use std::path::{Path, PathBuf};
 use tyrekit::data::{csvio, load, tdx, Format, LoadOptions, Loaded};
 use tyrekit::mf::Tyre;
 use tyrekit::rig::{simulate, RigConfig, SteadyMf};
 use tyrekit::Error;
 
-fn tmp(name: &str, content: &[u8]) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tyrekit-data-formats-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
+/// `content` written to `name` in the test's scratch folder `d`.
+fn tmp(d: &Path, name: &str, content: &[u8]) -> PathBuf {
     let p = d.join(name);
     std::fs::write(&p, content).unwrap();
     p
 }
 
-fn load_str(name: &str, content: &str) -> tyrekit::Result<Loaded> {
-    load(&tmp(name, content.as_bytes()), &LoadOptions::default())
+fn load_str(d: &Path, name: &str, content: &str) -> tyrekit::Result<Loaded> {
+    load(&tmp(d, name, content.as_bytes()), &LoadOptions::default())
 }
 
 fn expect_recording_error(r: tyrekit::Result<Loaded>, want_loc: &str) -> String {
@@ -50,19 +50,20 @@ fn same_samples(a: &[tyrekit::data::Sample], b: &[tyrekit::data::Sample]) {
     }
 }
 
-fn rig_loaded(name: &str) -> Loaded {
+fn rig_loaded(d: &Path, name: &str) -> Loaded {
     let tyre = Tyre::builtin();
     let mut cfg = RigConfig::standard(&tyre, 2);
     cfg.decimate = 5;
     cfg.programme.pressures.truncate(1);
     let r = simulate(&cfg, &mut SteadyMf::new(tyre));
-    let p = tmp(name, &tyrekit::data::ttc::write_mat(&r.table, true));
+    let p = tmp(d, name, &tyrekit::data::ttc::write_mat(&r.table, true));
     load(&p, &LoadOptions::default()).unwrap()
 }
 
 #[test]
 fn csv_and_tydex_round_trip_the_clean_table() {
-    let l = rig_loaded("small-rt.mat");
+    let d = scratch("data-formats");
+    let l = rig_loaded(d.path(), "small-rt.mat");
     let rec = &l.recording;
     let csv = csvio::write(rec);
     let head = csv.lines().next().unwrap();
@@ -75,14 +76,14 @@ fn csv_and_tydex_round_trip_the_clean_table() {
         remove_warmup: false,
         ..Default::default()
     };
-    let back = load(&tmp("rt.csv", csv.as_bytes()), &opts).unwrap();
+    let back = load(&tmp(d.path(), "rt.csv", csv.as_bytes()), &opts).unwrap();
     same_samples(&back.recording.samples, &rec.samples);
     assert_eq!(back.report.kappa, "recorded channel");
     // Same structure found again on the clean table.
     assert_eq!(back.recording.segments.len(), rec.segments.len());
     let t = tdx::write(rec);
     assert!(t.contains("**MEASURCHANNELS") && t.contains("SLIPANGL") && t.ends_with("**END\n"));
-    let back = load(&tmp("rt.tdx", t.as_bytes()), &opts).unwrap();
+    let back = load(&tmp(d.path(), "rt.tdx", t.as_bytes()), &opts).unwrap();
     assert_eq!(back.report.format, "Tydex");
     same_samples(&back.recording.samples, &rec.samples);
     assert_eq!(back.recording.segments.len(), rec.segments.len());
@@ -90,6 +91,7 @@ fn csv_and_tydex_round_trip_the_clean_table() {
 
 #[test]
 fn mfeval_aliases_units_nan_and_range() {
+    let d = scratch("data-formats");
     // MFeval column names with units; degrees and kPa are converted.
     let text = "Time [s],Vx [m/s],W [rad/s],SA [deg],IA [deg],Rl [m],Re [m],P [kPa],Fx [N],Fy [N],Fz [N],Mx [Nm],Mz [Nm],SR [-],Phit [-]\n\
         0.0,16,64,1,0,0.25,0.253,83,0,-300,1600,-10,5,0,0\n\
@@ -97,7 +99,7 @@ fn mfeval_aliases_units_nan_and_range() {
         0.2,16,64,3,0,0.25,0.253,83,0,-900,1600,-10,5,0,0\n\
         0.3,16,64,95,0,0.25,0.253,83,0,-900,1600,-10,5,0,0\n\
         0.4,16,64,4,0,0.25,0.253,83,0,-1100,1600,-10,5,,0\n";
-    let l = load_str("mfeval.csv", text).unwrap();
+    let l = load_str(d.path(), "mfeval.csv", text).unwrap();
     let r = &l.recording;
     assert_eq!(l.report.rows_read, 5);
     // NaN Fy, α = 95° and an empty SR are dropped, each counted once.
@@ -126,7 +128,9 @@ fn mfeval_aliases_units_nan_and_range() {
 
 #[test]
 fn missing_channels_are_reported() {
+    let d = scratch("data-formats");
     let l = load_str(
+        d.path(),
         "min.csv",
         "time,Fz,alpha,Fy\n0,1000,0.01,-100\n0.1,1000,0.02,-200\n",
     )
@@ -148,52 +152,53 @@ fn missing_channels_are_reported() {
     );
     assert!(l.recording.samples.iter().all(|s| s.kappa == 0.0));
     // No normal load: an error, not a guess.
-    expect_recording_error(load_str("nofz.csv", "time,Fy\n0,1\n"), "FZ");
+    expect_recording_error(load_str(d.path(), "nofz.csv", "time,Fy\n0,1\n"), "FZ");
 }
 
 #[test]
 fn malformed_files_name_the_place() {
+    let d = scratch("data-formats");
     // CSV: short row, non-number.
     expect_recording_error(
-        load_str("short.csv", "time,Fz,Fy\n0,1000,5\n0.1,1000\n"),
+        load_str(d.path(), "short.csv", "time,Fz,Fy\n0,1000,5\n0.1,1000\n"),
         "line 3",
     );
     let m = expect_recording_error(
-        load_str("text.csv", "time,Fz,Fy\n0,1000,abc\n"),
+        load_str(d.path(), "text.csv", "time,Fz,Fy\n0,1000,abc\n"),
         "line 2, column 'Fy'",
     );
     assert!(m.contains("abc"));
     // TTC .dat: unit row mismatch, truncated last row, unknown unit.
     let dat = "ET\tV\tSA\tFZ\tFY\ns\tkph\tdeg\tN\tN\n0\t40\t1\t-1000\t50\n0.01\t40\t1";
-    expect_recording_error(load_str("trunc.dat", dat), "line 4");
+    expect_recording_error(load_str(d.path(), "trunc.dat", dat), "line 4");
     let dat = "ET\tV\tSA\tFZ\tFY\ns\tkph\tdeg\tkgf\tN\n0\t40\t1\t-1000\t50\n";
-    let m = expect_recording_error(load_str("unit.dat", dat), "FZ");
+    let m = expect_recording_error(load_str(d.path(), "unit.dat", dat), "FZ");
     assert!(m.contains("kgf"));
     let dat = "ET\tV\tSA\tFZ\tFY\ns\tkph\tdeg\tN\n0\t40\t1\t-1000\t50\n";
-    expect_recording_error(load_str("units.dat", dat), "line 2");
+    expect_recording_error(load_str(d.path(), "units.dat", dat), "line 2");
     // TYDEX without data section, and a data row with too few values.
     let t = "**HEADER\nRELEASE 1.3\n**MEASURCHANNELS\nRUNTIME time s 1 0 0\nFZW load N 1 0 0\n";
-    expect_recording_error(load_str("nodata.tdx", t), "MEASURDATA");
+    expect_recording_error(load_str(d.path(), "nodata.tdx", t), "MEASURDATA");
     let t = "**HEADER\n**MEASURCHANNELS\nRUNTIME time s 1 0 0\nFZW load N 1 0 0\n**MEASURDATA\n0 1000\n0.1\n**END\n";
-    expect_recording_error(load_str("row.tdx", t), "line 7");
+    expect_recording_error(load_str(d.path(), "row.tdx", t), "line 7");
     // MAT: a valid file cut short.
     let tyre = Tyre::builtin();
     let mut cfg = RigConfig::standard(&tyre, 9);
     cfg.decimate = 50;
     let r = simulate(&cfg, &mut SteadyMf::new(tyre));
     let bytes = tyrekit::data::ttc::write_mat(&r.table, true);
-    let p = tmp("cut.mat", &bytes[..bytes.len() * 2 / 3]);
+    let p = tmp(d.path(), "cut.mat", &bytes[..bytes.len() * 2 / 3]);
     let e = load(&p, &LoadOptions::default());
     let m = expect_recording_error(e, "element");
     assert!(m.contains("truncated"), "{m}");
     // Unknown format.
-    let p = tmp("mystery.bin", b"\x00\x01\x02");
+    let p = tmp(d.path(), "mystery.bin", b"\x00\x01\x02");
     assert!(matches!(
         load(&p, &LoadOptions::default()),
         Err(Error::Recording { .. })
     ));
     // Forcing the format overrides detection.
-    let p = tmp("renamed.txt", b"time,Fz\n0,1000\n0.1,1000\n");
+    let p = tmp(d.path(), "renamed.txt", b"time,Fz\n0,1000\n0.1,1000\n");
     let o = LoadOptions {
         format: Some(Format::Csv),
         ..Default::default()
@@ -206,6 +211,7 @@ fn malformed_files_name_the_place() {
 #[test]
 #[ignore]
 fn million_rows_load_time() {
+    let d = scratch("data-formats");
     let n = 1_000_000;
     let mut s = String::from("time,Vx,omega,Fz,kappa,alpha,gamma,P,Fx,Fy,Mx,My,Mz\n");
     for i in 0..n {
@@ -224,7 +230,7 @@ fn million_rows_load_time() {
             8.0 * a * 10.0,
         ));
     }
-    let p = tmp("million.csv", s.as_bytes());
+    let p = tmp(d.path(), "million.csv", s.as_bytes());
     let t0 = std::time::Instant::now();
     let l = load(&p, &LoadOptions::default()).unwrap();
     let dt = t0.elapsed();
@@ -245,7 +251,7 @@ fn million_rows_load_time() {
     cfg.sample_rate = 800.0;
     let r = simulate(&cfg, &mut SteadyMf::new(tyre));
     let bytes = tyrekit::data::ttc::write_mat(&r.table, true);
-    let p = tmp("big.mat", &bytes);
+    let p = tmp(d.path(), "big.mat", &bytes);
     let t0 = std::time::Instant::now();
     let l = load(&p, &LoadOptions::default()).unwrap();
     println!(
@@ -264,6 +270,7 @@ fn million_rows_load_time() {
 /// nothing (reported missing, with why) on a drive/brake run without either.
 #[test]
 fn slip_without_a_wheel_speed() {
+    let d = scratch("data-formats");
     // TTC layout (SAE axes, kph, deg): a brake sweep to SR = ∓0.1, Fx ±800 N at 1 kN.
     let ttc = |sr_scale: f64, with_sr: bool| {
         let mut t = String::from(if with_sr {
@@ -285,7 +292,7 @@ fn slip_without_a_wheel_speed() {
         }
         t
     };
-    let l = load_str("sr.dat", &ttc(1.0, true)).unwrap();
+    let l = load_str(d.path(), "sr.dat", &ttc(1.0, true)).unwrap();
     assert!(
         l.report.kappa.starts_with("κ = the recorded slip ratio SR"),
         "{}",
@@ -296,14 +303,14 @@ fn slip_without_a_wheel_speed() {
         assert!((s.kappa + 0.1 * x).abs() < 1e-9, "κ {} at row {i}", s.kappa);
     }
     // SR in percent is not a ratio: not taken as κ, and the run brakes, so no κ = 0 either.
-    let l = load_str("srpct.dat", &ttc(100.0, true)).unwrap();
+    let l = load_str(d.path(), "srpct.dat", &ttc(100.0, true)).unwrap();
     assert!(
         l.report.kappa.starts_with("missing") && l.report.kappa.contains("does not roll freely"),
         "{}",
         l.report.kappa
     );
     // No slip channel on a drive/brake run: the same.
-    let l = load_str("nosr.dat", &ttc(1.0, false)).unwrap();
+    let l = load_str(d.path(), "nosr.dat", &ttc(1.0, false)).unwrap();
     assert!(l.report.kappa.starts_with("missing"), "{}", l.report.kappa);
     // A CSV that rolls freely (|Fx| ≪ Fz) without wheel speed or slip: κ = 0.
     let mut t = String::from("time,Vx,Fz,alpha,Fx,Fy\n");
@@ -315,7 +322,7 @@ fn slip_without_a_wheel_speed() {
             -20000.0 * a
         ));
     }
-    let l = load_str("free.csv", &t).unwrap();
+    let l = load_str(d.path(), "free.csv", &t).unwrap();
     assert!(l.report.kappa.starts_with("κ = 0"), "{}", l.report.kappa);
     assert!(l.recording.samples.iter().all(|s| s.kappa == 0.0));
 }
@@ -355,8 +362,9 @@ fn ttc_without_slip(blocks: &[(f64, bool)], fx0: f64) -> String {
 /// brake-only run is still refused.
 #[test]
 fn cornering_blocks_of_a_run_without_any_slip_keep_free_rolling() {
+    let d = scratch("data-formats");
     let t = ttc_without_slip(&[(20.0, false), (10.0, true), (20.0, false)], 0.0);
-    let l = load_str("mixed.dat", &t).unwrap();
+    let l = load_str(d.path(), "mixed.dat", &t).unwrap();
     assert!(
         l.report
             .kappa
@@ -384,6 +392,7 @@ fn cornering_blocks_of_a_run_without_any_slip_keep_free_rolling() {
     // peak for 4 s each, a dense band of Fx/Fz that must not pass for a
     // free-rolling level.
     let l = load_str(
+        d.path(),
         "brake.dat",
         &ttc_without_slip(&[(10.0, true), (10.0, true)], 0.0),
     )
@@ -397,7 +406,13 @@ fn cornering_blocks_of_a_run_without_any_slip_keep_free_rolling() {
 /// tyre of the dev set — still rolls freely (|Fx| < 10 % Fz had refused it).
 #[test]
 fn a_cornering_run_with_a_free_rolling_fx_offset_rolls_freely() {
-    let l = load_str("offset.dat", &ttc_without_slip(&[(30.0, false)], -90.0)).unwrap();
+    let d = scratch("data-formats");
+    let l = load_str(
+        d.path(),
+        "offset.dat",
+        &ttc_without_slip(&[(30.0, false)], -90.0),
+    )
+    .unwrap();
     assert!(
         l.report
             .kappa

@@ -5,6 +5,7 @@
 //! the same SAE file read with `--axes sae` must fit. Runs the binary.
 //! Skips (with a message) when ../shared is absent.
 
+use crate::common::scratch;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -14,9 +15,8 @@ fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_tyrekit"))
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tyrekit-misuse-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
+/// `name` in the test's scratch folder `d`.
+fn tmp(d: &Path, name: &str) -> PathBuf {
     d.join(name)
 }
 
@@ -94,11 +94,12 @@ fn s(p: &Path) -> &str {
 
 #[test]
 fn sae_signs_read_as_iso_stop_every_command() {
+    let d = scratch("misuse");
     let Some(text) = shared() else { return };
-    let p = tmp("sae.csv");
+    let p = tmp(d.path(), "sae.csv");
     std::fs::write(&p, sae(&text)).unwrap();
-    let out = tmp("sae.tir");
-    let rep = tmp("sae_report");
+    let out = tmp(d.path(), "sae.tir");
+    let rep = tmp(d.path(), "sae_report");
     let needles = ["Fz < 0", "--axes sae"];
     assert_fails(&["fit", s(&p), "--out", s(&out), "--only", "fy"], &needles);
     assert!(!out.exists(), "a .tir was written");
@@ -110,7 +111,7 @@ fn sae_signs_read_as_iso_stop_every_command() {
             "--tir",
             "src/tir/builtin.tir",
             "--out",
-            s(&tmp("sae_sim.csv")),
+            s(&tmp(d.path(), "sae_sim.csv")),
         ],
         &needles,
     );
@@ -119,10 +120,11 @@ fn sae_signs_read_as_iso_stop_every_command() {
 
 #[test]
 fn sae_file_with_axes_sae_fits() {
+    let d = scratch("misuse");
     let Some(text) = shared() else { return };
-    let p = tmp("sae_ok.csv");
+    let p = tmp(d.path(), "sae_ok.csv");
     std::fs::write(&p, sae(&text)).unwrap();
-    let out = tmp("sae_ok.tir");
+    let out = tmp(d.path(), "sae_ok.tir");
     let (ok, err) = run(&[
         "fit",
         s(&p),
@@ -139,26 +141,33 @@ fn sae_file_with_axes_sae_fits() {
 
 #[test]
 fn degrees_in_a_radian_column_stop_fit_and_diagnose() {
+    let d = scratch("misuse");
     let Some(text) = shared() else { return };
     let deg = 180.0 / std::f64::consts::PI;
-    let p = tmp("deg.csv");
+    let p = tmp(d.path(), "deg.csv");
     // SA values in degrees, the header still says [rad].
     std::fs::write(&p, rewrite(&text, |h| h.to_string(), &[("SA", deg)])).unwrap();
     let needles = ["degrees", "alpha", "SA [deg]"];
-    let out = tmp("deg.tir");
+    let out = tmp(d.path(), "deg.tir");
     assert_fails(&["fit", s(&p), "--out", s(&out), "--only", "fy"], &needles);
     assert!(!out.exists());
     assert_fails(
-        &["diagnose", s(&p), "--report", s(&tmp("deg_report"))],
+        &[
+            "diagnose",
+            s(&p),
+            "--report",
+            s(&tmp(d.path(), "deg_report")),
+        ],
         &needles,
     );
 }
 
 #[test]
 fn no_usable_stage_is_an_error_not_a_written_file() {
+    let d = scratch("misuse");
     // A recording with load and speed but no force or moment channel: every
     // stage is skipped, so nothing may be written and the exit is non-zero.
-    let p = tmp("noforce.csv");
+    let p = tmp(d.path(), "noforce.csv");
     let mut t = String::from("time,Vx,omega,Fz,alpha,gamma\n");
     for i in 0..400 {
         let a = 0.2 * ((i as f64) * 0.05).sin();
@@ -171,25 +180,31 @@ fn no_usable_stage_is_an_error_not_a_written_file() {
         ));
     }
     std::fs::write(&p, t).unwrap();
-    let out = tmp("noforce.tir");
+    let out = tmp(d.path(), "noforce.tir");
     assert_fails(
         &["fit", s(&p), "--out", s(&out)],
         &["no stage had usable data"],
     );
     assert!(!out.exists());
     assert_fails(
-        &["diagnose", s(&p), "--report", s(&tmp("noforce_report"))],
+        &[
+            "diagnose",
+            s(&p),
+            "--report",
+            s(&tmp(d.path(), "noforce_report")),
+        ],
         &["cannot be analysed"],
     );
 }
 
 #[test]
 fn a_drive_brake_run_without_any_slip_says_why_no_stage_fits() {
+    let d = scratch("misuse");
     // Braking sweeps at 4 kN (|Fx| to 60 % of Fz) with no wheel speed and
     // no slip channel: κ cannot be known and free rolling cannot be
     // assumed. The error must name the missing slip, not only count zero
     // samples in segments that are plainly there.
-    let p = tmp("noslip.csv");
+    let p = tmp(d.path(), "noslip.csv");
     let mut t = String::from("time,Vx,Fz,alpha,gamma,Fx,Fy\n");
     for i in 0..2000 {
         let x = ((i as f64) * 0.01).sin();
@@ -201,7 +216,7 @@ fn a_drive_brake_run_without_any_slip_says_why_no_stage_fits() {
         ));
     }
     std::fs::write(&p, t).unwrap();
-    let out = tmp("noslip.tir");
+    let out = tmp(d.path(), "noslip.tir");
     assert_fails(
         &["fit", s(&p), "--out", s(&out)],
         &["no slip ratio κ", "data summary"],

@@ -2,14 +2,14 @@
 //! within the rig's noise, the signs are right, the warm-up is cut where the
 //! programme starts, and the test matrix (segments and set points) is found.
 
+use crate::common::scratch;
 use std::path::{Path, PathBuf};
 use tyrekit::data::{load, Format, LoadOptions, Loaded, ReChoice, Recording, SegmentKind};
 use tyrekit::mf::Tyre;
 use tyrekit::rig::{simulate, Noise, RigConfig, RigRun, SteadyMf, TtcUnits};
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tyrekit-data-rig-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
+/// `name` in the test's scratch folder `d`.
+fn tmp(d: &Path, name: &str) -> PathBuf {
     d.join(name)
 }
 
@@ -190,6 +190,7 @@ fn check_sweep_dir(rec: &Recording) {
 
 #[test]
 fn rig_mat_and_dat_recover_the_iso_truth() {
+    let d = scratch("data-rig");
     let (cfg, r) = run(TtcUnits::Si, 7);
     assert!(r.rows() > 100_000);
     // Raw TTC signs: a positive ISO slip angle is a negative SAE SA, and
@@ -216,8 +217,8 @@ fn rig_mat_and_dat_recover_the_iso_truth() {
     assert!(n_checked > 1000);
     // The built-in tyre's ISO Fy opposes α (PKY1 < 0 in ISO): a positive SAE
     // SA therefore gives a positive ISO Fy after reading.
-    let pm = tmp("rig.mat");
-    let pd = tmp("rig.dat");
+    let pm = tmp(d.path(), "rig.mat");
+    let pd = tmp(d.path(), "rig.dat");
     r.write_mat(&pm, true).unwrap();
     r.write_dat(&pd).unwrap();
     for p in [&pm, &pd] {
@@ -237,14 +238,13 @@ fn rig_mat_and_dat_recover_the_iso_truth() {
             assert!(l.recording.extra(e).is_some(), "extra {e} missing");
         }
     }
-    let _ = std::fs::remove_file(&pm);
-    let _ = std::fs::remove_file(&pd);
 }
 
 #[test]
 fn kappa_from_wheel_speed_and_the_disturbed_recorded_re() {
+    let d = scratch("data-rig");
     let (_, r) = run(TtcUnits::Si, 11);
-    let p = tmp("kappa.mat");
+    let p = tmp(d.path(), "kappa.mat");
     r.write_mat(&p, false).unwrap();
     // Free-rolling Re(Fz): κ within noise of the imposed κ. Noise on Ω
     // (0.02 rad/s of ~37 rad/s) and V (0.02 of 11.1 m/s) gives σκ ≈ 0.0018.
@@ -295,11 +295,11 @@ fn kappa_from_wheel_speed_and_the_disturbed_recorded_re() {
         .map(|s| (s.kappa - r.truth[truth_index(&r, s.time)].kappa).abs())
         .fold(0.0, f64::max);
     assert!(err < 0.012, "κ with model Re: {err}");
-    let _ = std::fs::remove_file(&p);
 }
 
 #[test]
 fn us_customary_export_reads_to_the_same_si_values() {
+    let d = scratch("data-rig");
     let (cfg, r) = run(TtcUnits::UsCustomary, 3);
     let units: Vec<&str> = r
         .table
@@ -308,16 +308,16 @@ fn us_customary_export_reads_to_the_same_si_values() {
         .map(|c| c.unit.as_deref().unwrap())
         .collect();
     assert!(units.contains(&"lb") && units.contains(&"psi") && units.contains(&"mph"));
-    let p = tmp("us.dat");
+    let p = tmp(d.path(), "us.dat");
     r.write_dat(&p).unwrap();
     let l = read(&p, ReChoice::FreeRolling);
     check_recovery(&l.recording, &r, &cfg);
     check_matrix(&l.recording, &r);
-    let _ = std::fs::remove_file(&p);
 }
 
 #[test]
 fn rig_is_reproducible_and_noise_free_run_is_exact() {
+    let d = scratch("data-rig");
     let (_, a) = run(TtcUnits::Si, 5);
     let (_, b) = run(TtcUnits::Si, 5);
     assert_eq!(a.table.columns, b.table.columns);
@@ -330,7 +330,7 @@ fn rig_is_reproducible_and_noise_free_run_is_exact() {
     cfg.programme.db_alphas.clear();
     cfg.decimate = 4;
     let r = simulate(&cfg, &mut SteadyMf::new(tyre));
-    let p = tmp("exact.mat");
+    let p = tmp(d.path(), "exact.mat");
     r.write_mat(&p, true).unwrap();
     let l = load(
         &p,
@@ -348,11 +348,11 @@ fn rig_is_reproducible_and_noise_free_run_is_exact() {
     }
     // Decimated to 25 Hz: the matrix is still found.
     assert_eq!(l.recording.segments.len(), 45);
-    let _ = std::fs::remove_file(&p);
 }
 
 #[test]
 fn warmup_at_its_own_load_is_cut_as_an_irregular_segment() {
+    let d = scratch("data-rig");
     let tyre = Tyre::builtin();
     let mut cfg = RigConfig::standard(&tyre, 21);
     if let Some(w) = cfg.programme.warmup.as_mut() {
@@ -360,7 +360,7 @@ fn warmup_at_its_own_load_is_cut_as_an_irregular_segment() {
     }
     cfg.decimate = 2;
     let r = simulate(&cfg, &mut SteadyMf::new(tyre));
-    let p = tmp("warm.mat");
+    let p = tmp(d.path(), "warm.mat");
     r.write_mat(&p, true).unwrap();
     let l = read(&p, ReChoice::FreeRolling);
     let w = l.report.warmup.as_ref().expect("warm-up detected");
@@ -376,12 +376,12 @@ fn warmup_at_its_own_load_is_cut_as_an_irregular_segment() {
     );
     assert!(w.reason.contains("unlike the programme"), "{}", w.reason);
     assert_eq!(l.recording.segments.len(), r.plan.len());
-    let _ = std::fs::remove_file(&p);
 }
 
 /// Other tyres, more noise, another sample rate: the structure is still found.
 #[test]
 fn structure_survives_other_tyres_noise_and_rates() {
+    let d = scratch("data-rig");
     let shared = std::env::var("TYREKIT_SHARED")
         .unwrap_or_else(|_| concat!(env!("CARGO_MANIFEST_DIR"), "/../shared").into());
     let mut tyres = vec![("builtin".to_string(), Tyre::builtin())];
@@ -412,7 +412,7 @@ fn structure_survives_other_tyres_noise_and_rates() {
             *x *= 2.0;
         }
         let r = simulate(&cfg, &mut SteadyMf::new(tyre));
-        let p = tmp(&format!("robust-{name}.mat"));
+        let p = tmp(d.path(), &format!("robust-{name}.mat"));
         r.write_mat(&p, true).unwrap();
         let l = read(&p, ReChoice::FreeRolling);
         assert_eq!(l.recording.segments.len(), r.plan.len(), "{name}");

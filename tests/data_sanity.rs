@@ -6,14 +6,14 @@
 //! channel must be rejected by name, the rows kept, κ taken as free rolling
 //! and every sweep found as pure lateral (not `combined`).
 
-use std::path::PathBuf;
+use crate::common::scratch;
+use std::path::{Path, PathBuf};
 use tyrekit::data::{load, LoadOptions, Loaded, Recording, SegmentKind};
 use tyrekit::mf::Tyre;
 use tyrekit::rig::{simulate, RigConfig, RigRun, SteadyMf, TtcUnits};
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tyrekit-data-sanity-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
+/// `name` in the test's scratch folder `d`.
+fn tmp(d: &Path, name: &str) -> PathBuf {
     d.join(name)
 }
 
@@ -114,6 +114,7 @@ fn check_dead_wheel_speed(l: &Loaded, plan_lateral: usize, what: &str) {
 
 #[test]
 fn ttc_dead_wheel_speed_dat_and_mat_si_and_us() {
+    let d = scratch("data-sanity");
     for units in [TtcUnits::Si, TtcUnits::UsCustomary] {
         let mut run = cornering_run(units);
         let plan_lateral = run
@@ -123,8 +124,8 @@ fn ttc_dead_wheel_speed_dat_and_mat_si_and_us() {
             .count();
         assert!(plan_lateral >= 6, "the programme has {plan_lateral} sweeps");
         kill_wheel_speed(&mut run);
-        let dat = tmp(&format!("dead_{units:?}.dat"));
-        let mat = tmp(&format!("dead_{units:?}.mat"));
+        let dat = tmp(d.path(), &format!("dead_{units:?}.dat"));
+        let mat = tmp(d.path(), &format!("dead_{units:?}.mat"));
         run.write_dat(&dat).unwrap();
         run.write_mat(&mat, true).unwrap();
         for p in [&dat, &mat] {
@@ -151,9 +152,10 @@ fn ttc_dead_wheel_speed_dat_and_mat_si_and_us() {
 
 #[test]
 fn healthy_ttc_cornering_keeps_its_channels() {
+    let d = scratch("data-sanity");
     // Control: the same export with a working wheel speed loses nothing.
     let run = cornering_run(TtcUnits::Si);
-    let p = tmp("healthy.dat");
+    let p = tmp(d.path(), "healthy.dat");
     run.write_dat(&p).unwrap();
     let l = read(&p);
     assert!(l.report.rejected.is_empty(), "{:?}", l.report.rejected);
@@ -171,6 +173,7 @@ fn healthy_ttc_cornering_keeps_its_channels() {
 
 #[test]
 fn absurd_moment_channel_loses_the_channel_not_the_rows() {
+    let d = scratch("data-sanity");
     let mut run = cornering_run(TtcUnits::Si);
     // Mx reads an absurd 9.9e5 N-m on 98 % of the rows (a saturated or
     // mis-scaled channel).
@@ -181,7 +184,7 @@ fn absurd_moment_channel_loses_the_channel_not_the_rows() {
             *x = 9.9e5;
         }
     }
-    let p = tmp("absurd_mx.dat");
+    let p = tmp(d.path(), "absurd_mx.dat");
     run.write_dat(&p).unwrap();
     let l = read(&p);
     assert!(rejected(&l, "Mx"), "{:?}", l.report.rejected);
@@ -194,8 +197,9 @@ fn absurd_moment_channel_loses_the_channel_not_the_rows() {
 
 #[test]
 fn tydex_dead_wheel_speed_and_pinned_slip() {
+    let d = scratch("data-sanity");
     let run = cornering_run(TtcUnits::Si);
-    let p = tmp("healthy_for_tdx.dat");
+    let p = tmp(d.path(), "healthy_for_tdx.dat");
     run.write_dat(&p).unwrap();
     let mut rec = read(&p).recording;
     let plan_lateral = count(&rec, SegmentKind::PureLateral);
@@ -206,7 +210,7 @@ fn tydex_dead_wheel_speed_and_pinned_slip() {
     }
     rec.extra
         .retain(|(n, _)| n != "Re" && n != "SR" && n != "SL");
-    let tdx = tmp("dead.tdx");
+    let tdx = tmp(d.path(), "dead.tdx");
     std::fs::write(&tdx, tyrekit::data::tdx::write(&rec)).unwrap();
     let l = read(&tdx);
     assert!(rejected(&l, "kappa"), "{:?}", l.report.rejected);
@@ -234,6 +238,7 @@ fn full_run(tyre: &Tyre, seed: u64) -> RigRun {
 /// without that force, and a diagnosis would read the channel's noise.
 #[test]
 fn a_force_channel_that_does_not_follow_its_slip_is_rejected() {
+    let d = scratch("data-sanity");
     let run = full_run(&Tyre::builtin(), 11);
     let mut dead_fx = run.clone();
     for (i, x) in col(&mut dead_fx, "FX").iter_mut().enumerate() {
@@ -242,7 +247,7 @@ fn a_force_channel_that_does_not_follow_its_slip_is_rejected() {
     let mut kn_fy = run;
     col(&mut kn_fy, "FY").iter_mut().for_each(|x| *x /= 1000.0);
     for (r, dead, live) in [(dead_fx, "Fx", "Fy"), (kn_fy, "Fy", "Fx")] {
-        let p = tmp(&format!("dead_{dead}.dat"));
+        let p = tmp(d.path(), &format!("dead_{dead}.dat"));
         r.write_dat(&p).unwrap();
         let l = read(&p);
         assert!(
@@ -272,6 +277,7 @@ fn a_force_channel_that_does_not_follow_its_slip_is_rejected() {
 /// recording below keeps its Mz as well.
 #[test]
 fn a_moment_channel_that_does_not_follow_the_lateral_force_is_rejected() {
+    let d = scratch("data-sanity");
     let run = full_run(&Tyre::builtin(), 13);
     let mut dead = run.clone();
     for (i, x) in col(&mut dead, "MZ").iter_mut().enumerate() {
@@ -280,7 +286,7 @@ fn a_moment_channel_that_does_not_follow_the_lateral_force_is_rejected() {
     let mut knm = run.clone();
     col(&mut knm, "MZ").iter_mut().for_each(|x| *x /= 1000.0);
     for (r, what) in [(dead, "dead"), (knm, "kN m")] {
-        let p = tmp(&format!("dead_mz_{}.dat", what.replace(' ', "_")));
+        let p = tmp(d.path(), &format!("dead_mz_{}.dat", what.replace(' ', "_")));
         r.write_dat(&p).unwrap();
         let l = read(&p);
         assert!(
@@ -297,7 +303,7 @@ fn a_moment_channel_that_does_not_follow_the_lateral_force_is_rejected() {
         );
         assert_eq!(l.report.dropped_total, 0, "{:?}", l.report.dropped);
     }
-    let p = tmp("live_mz.dat");
+    let p = tmp(d.path(), "live_mz.dat");
     run.write_dat(&p).unwrap();
     let l = read(&p);
     assert!(l.report.rejected.is_empty(), "{:?}", l.report.rejected);
@@ -329,11 +335,12 @@ fn a_moment_channel_that_does_not_follow_the_lateral_force_is_rejected() {
 /// what ice gives.
 #[test]
 fn force_channels_of_a_tyre_on_ice_are_kept() {
+    let d = scratch("data-sanity");
     let mut ice = tyrekit::tir::TyreParams::builtin();
     ice.set("LMUX", 0.06).unwrap();
     ice.set("LMUY", 0.06).unwrap();
     for (t, what) in [(Tyre::new(ice).unwrap(), "ice"), (Tyre::builtin(), "dry")] {
-        let p = tmp(&format!("forces_{what}.dat"));
+        let p = tmp(d.path(), &format!("forces_{what}.dat"));
         full_run(&t, 12).write_dat(&p).unwrap();
         let l = read(&p);
         assert!(

@@ -4,7 +4,8 @@
 //! from their free-rolling samples, also with a large rolling resistance,
 //! and the loader then derives κ in the recording's own reference.
 
-use std::path::PathBuf;
+use crate::common::scratch;
+use std::path::{Path, PathBuf};
 use tyrekit::data::slip_reference::{detect, SlipReference};
 use tyrekit::data::{load, LoadOptions, Sample};
 
@@ -153,9 +154,7 @@ fn no_slip_angle_leverage_leaves_the_decision_open() {
     assert!(detect(&s, &v).is_none());
 }
 
-fn write_csv(name: &str, s: &[Sample], v: &[f64]) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tyrekit-slipref-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
+fn write_csv(d: &Path, name: &str, s: &[Sample], v: &[f64]) -> PathBuf {
     let p = d.join(name);
     let mut txt = String::from(
         "Time [s],V [m/s],W [rad/s],SA [rad],IA [rad],Re [m],P [Pa],Fx [N],Fy [N],Fz [N]\n",
@@ -182,9 +181,10 @@ fn write_csv(name: &str, s: &[Sample], v: &[f64]) -> PathBuf {
 #[test]
 fn the_loader_derives_kappa_in_the_recordings_own_reference() {
     let tyre = Tyre { rr: -0.015 };
+    let d = scratch("slipref");
     for reference in [SlipReference::WheelPlane, SlipReference::Belt] {
         let (s, v) = programme(&tyre, reference, true);
-        let p = write_csv(&format!("{reference:?}.csv"), &s, &v);
+        let p = write_csv(d.path(), &format!("{reference:?}.csv"), &s, &v);
         let l = load(
             &p,
             &LoadOptions {

@@ -4,6 +4,7 @@
 //! loading in the library and replaying, and clear errors (exit code 1, a
 //! message naming the flag or file, no panic) on bad flags and files.
 
+use crate::common::scratch;
 use std::path::Path;
 use std::process::{Command, Output};
 use tyrekit::mf::Tyre;
@@ -30,8 +31,8 @@ fn fails_clearly(o: &Output, needle: &str) {
 
 #[test]
 fn replay_and_diagnose_commands() {
-    let dir = std::env::temp_dir().join(format!("tyrekit-diag-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("diag-cli");
+    let dir = tmp.path();
     let tyre = Tyre::builtin();
     let tir = dir.join("base.tir");
     tyre.params().write(&tir).unwrap();
@@ -189,5 +190,4 @@ fn replay_and_diagnose_commands() {
         s(&out),
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let _ = std::fs::remove_dir_all(&dir);
 }

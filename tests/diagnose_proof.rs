@@ -130,11 +130,12 @@ fn diagnose_one(
     make: &dyn Fn() -> Box<dyn TruthModel>,
     seed: u64,
 ) -> Outcome {
-    let dir = std::env::temp_dir().join(format!("tyrekit_proof_{}_{seed}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let rec = record(tyre, expect, make().as_mut(), seed, &dir);
+    // The recording is read back whole: its folder goes at the block's end.
+    let rec = {
+        let d = common::scratch(&format!("proof-{seed}"));
+        record(tyre, expect, make().as_mut(), seed, d.path())
+    };
     let truth = replay_truth(make().as_mut(), &rec);
-    let _ = std::fs::remove_dir_all(&dir);
     let owned = all();
     let cands: Vec<&dyn Candidate> = owned.iter().map(|c| c.as_ref()).collect();
     let ev = evaluate(&rec, tyre, &opts(), &cands).unwrap();

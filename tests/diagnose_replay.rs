@@ -2,6 +2,7 @@
 //! steady replay; with a concealed relaxation lag, the relaxation replay beats
 //! the steady one.
 
+use crate::common::scratch;
 use tyrekit::data::structure::sweep_and_time;
 use tyrekit::data::{Recording, SegmentKind, SAMPLE_CHANNELS};
 use tyrekit::diagnose::replay::{replay, write_csv, ReplayOptions};
@@ -251,9 +252,8 @@ fn ttc_file_path_replays_lateral_runs() {
     let tyre = Tyre::builtin();
     let mut truth = effects::concealed("none", tyre.clone(), 1.0).unwrap();
     let run = simulate(&short_cfg(&tyre), truth.as_mut());
-    let dir = std::env::temp_dir().join(format!("tyrekit-diag-replay-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join("steady.mat");
+    let dir = scratch("diag-replay");
+    let p = dir.path().join("steady.mat");
     run.write_mat(&p, false).unwrap();
     let rec = Recording::from_file(&p).unwrap();
     let opts = ReplayOptions {

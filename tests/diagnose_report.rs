@@ -3,7 +3,8 @@
 //! flat-belt test `../shared/data/measurements/TyreData.csv`; every output
 //! written and consistent; the explanation's wording.
 
-use std::path::{Path, PathBuf};
+use crate::common::scratch;
+use std::path::Path;
 use std::process::Command;
 use tyrekit::diagnose::locate::Finding;
 use tyrekit::diagnose::report::{caution, findings_in_words, QualityRow};
@@ -22,21 +23,6 @@ const NAMES: [&str; 9] = [
     "rolling_radius",
     "camber",
 ];
-
-fn tmp(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tyrekit-diag-report-{tag}-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// Remove a test's folder, or keep it (and say where) when `KEEP` is set.
-fn cleanup(dir: &Path) {
-    if std::env::var_os("KEEP").is_none() {
-        let _ = std::fs::remove_dir_all(dir);
-    } else {
-        eprintln!("kept {}", dir.display());
-    }
-}
 
 fn run_diagnose(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_tyrekit"))
@@ -157,7 +143,9 @@ fn check_outputs(rep: &Path) -> serde_json::Value {
 /// force, the rig noise ~1 %).
 #[test]
 fn no_tir_on_rig_recording() {
-    let dir = tmp("rig");
+    // Removed when the test ends; kept (path on stderr) with TYREKIT_KEEP set.
+    let tmp = scratch("diag-report-rig");
+    let dir = tmp.path();
     let tyre = Tyre::builtin();
     let mut cfg = RigConfig::standard(&tyre, 3);
     cfg.programme.pressures.truncate(1);
@@ -206,7 +194,6 @@ fn no_tir_on_rig_recording() {
     let base = Tyre::from_file(&rep.join("baseline.tir")).unwrap();
     assert_eq!(base.params().p.ppy1, 0.0);
     assert_eq!(base.params().p.ppx1, 0.0);
-    cleanup(&dir);
 }
 
 /// A recording without the slip ratio channel cannot show a rolling radius
@@ -222,7 +209,8 @@ fn a_recording_without_sr_says_the_radius_was_not_checked() {
         eprintln!("skipped: {} absent", gz.display());
         return;
     }
-    let dir = tmp("nosr");
+    let tmp = scratch("diag-report-nosr");
+    let dir = tmp.path();
     let lines: Vec<String> = std::io::BufReader::new(flate2::read::GzDecoder::new(
         std::fs::File::open(&gz).unwrap(),
     ))
@@ -267,7 +255,6 @@ fn a_recording_without_sr_says_the_radius_was_not_checked() {
         !says(&gz, "with"),
         "the sentence appears though SR is recorded"
     );
-    cleanup(&dir);
 }
 
 /// The real flat-belt lateral test (MFeval's fitting example): runs end to
@@ -281,7 +268,8 @@ fn real_tyre_data_end_to_end() {
         eprintln!("skipped: {} absent", csv.display());
         return;
     }
-    let dir = tmp("real");
+    let tmp = scratch("diag-report-real");
+    let dir = tmp.path();
     let rep = dir.join("report");
     let o = run_diagnose(&[csv.to_str().unwrap(), "--report", rep.to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -345,7 +333,6 @@ fn real_tyre_data_end_to_end() {
             assert!(g >= -0.05, "verdict worsens {}: {g}", c["channel"]);
         }
     }
-    cleanup(&dir);
 }
 
 fn finding(name: &'static str, groups: &[(&str, f64)]) -> Finding {

@@ -98,8 +98,8 @@ fn the_baseline_fits_controls_of_other_real_tyres_within_the_noise() {
         eprintln!("SKIP the_baseline_fits_controls_of_other_real_tyres_within_the_noise: ../shared/data/tir is absent");
         return;
     }
-    let dir = std::env::temp_dir().join(format!("tyrekit-diag-tyres-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = common::scratch("diag-tyres");
+    let dir = tmp.path();
     let mut bad = Vec::new();
     for (k, (file, why)) in TYRES.iter().enumerate() {
         let tyre = Tyre::from_file(&tir.join(file)).expect("a shared tyre file");
@@ -140,7 +140,6 @@ fn the_baseline_fits_controls_of_other_real_tyres_within_the_noise() {
             bad.push(format!("{file}: verdict {}, {fits:?}", d["verdict"]));
         }
     }
-    let _ = std::fs::remove_dir_all(&dir);
     assert!(
         bad.is_empty(),
         "controls not fitted within the noise: {bad:?}"
@@ -161,8 +160,8 @@ fn a_recording_whose_forces_follow_no_slip_names_nothing() {
         eprintln!("SKIP a_recording_whose_forces_follow_no_slip_names_nothing: ../shared/data/tir is absent");
         return;
     }
-    let dir = std::env::temp_dir().join(format!("tyrekit-diag-dead-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = common::scratch("diag-dead");
+    let dir = tmp.path();
     let rec = dir.join("template.mat");
     control(
         &Tyre::from_file(&tir).expect("the template file"),
@@ -180,5 +179,4 @@ fn a_recording_whose_forces_follow_no_slip_names_nothing() {
         );
     }
     assert_eq!(d["verdict"], "none", "{}", d["explanation"]);
-    let _ = std::fs::remove_dir_all(&dir);
 }

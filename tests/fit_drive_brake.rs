@@ -13,6 +13,7 @@
 //! stage was skipped and Fy0 stayed the start tyre's; on the dev set cut to
 //! its drive/brake rows that left Fy at 17× the noise floor.
 
+use crate::common::scratch;
 use tyrekit::data::{Recording, SegmentKind};
 use tyrekit::fit::mf_fit::{fit_mf, MfFitOptions};
 use tyrekit::fit::mf_stages::USE_MODE;
@@ -87,9 +88,8 @@ fn sigma_fy(rec: &Recording, model: &Tyre, offsets: Option<&Noise>) -> f64 {
 fn a_drive_brake_run_fits_fy_without_cornering_sweeps() {
     let truth_p = truth();
     let truth = Tyre::new(truth_p.clone()).unwrap();
-    let tmp = std::env::temp_dir().join(format!("tyrekit_fit_db_{}", std::process::id()));
-    std::fs::create_dir_all(&tmp).unwrap();
-    let rec = recording(&truth, &tmp);
+    let tmp = scratch("fit-db");
+    let rec = recording(&truth, tmp.path());
     assert!(
         !rec.segments
             .iter()
@@ -140,5 +140,4 @@ fn a_drive_brake_run_fits_fy_without_cornering_sweeps() {
     for k in ["PCY1", "PEY1", "PEY2", "PKY4", "PVY1"] {
         assert_eq!(res.tyre.get(k), start_p.get(k), "{k} moved");
     }
-    let _ = std::fs::remove_dir_all(&tmp);
 }

@@ -11,6 +11,8 @@
 //! loads 0.5–1.5 × FNOMIN, cambers 0–4°) from the built-in tyre at a low
 //! sample rate (a few seconds of fitting in release).
 
+use crate::common::scratch;
+use std::path::{Path, PathBuf};
 use tyrekit::data::Recording;
 use tyrekit::fit::mf_fit::{fit_mf, MfFitOptions};
 use tyrekit::fit::mf_stages::{StageKind, FIT_MODE};
@@ -19,24 +21,21 @@ use tyrekit::mf::{MfInput, Tyre, UseMode};
 use tyrekit::rig::{simulate, RigConfig, SteadyMf};
 use tyrekit::tir::TyreParams;
 
-/// The rig recording written to `DIR/rig.mat` (DIR a fresh temporary folder).
-fn rig_file(tag: &str) -> (std::path::PathBuf, std::path::PathBuf) {
+/// The rig recording written to `DIR/rig.mat` (DIR the test's scratch folder).
+fn rig_file(dir: &Path) -> PathBuf {
     let truth = Tyre::builtin();
     let mut cfg = RigConfig::standard(&truth, 5);
     cfg.sample_rate = 40.0;
     let run = simulate(&cfg, &mut SteadyMf::new(truth));
-    let dir = std::env::temp_dir().join(format!("tyrekit_fit_hold_{}_{tag}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("rig.mat");
     run.write_mat(&path, false).unwrap();
-    (dir, path)
+    path
 }
 
+/// The rig recording, read back whole (its folder ends with this call).
 fn recording(tag: &str) -> Recording {
-    let (dir, path) = rig_file(tag);
-    let rec = Recording::from_file(&path).unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
-    rec
+    let d = scratch(&format!("fit-hold-{tag}"));
+    Recording::from_file(&rig_file(d.path())).unwrap()
 }
 
 fn opts(only: Vec<StageKind>) -> MfFitOptions {
@@ -103,10 +102,10 @@ fn fitted_tyre_ranges_cover_the_data() {
     // mode 1xx, as the FMU runs) gives the same Fy at the lowest pressure
     // as without them: the pressure is no longer clipped. (With the start
     // file's PRESMIN it would be evaluated at 0.95 × NOMPRES instead.)
-    let path = std::env::temp_dir().join(format!("tyrekit_fit_hold_{}.tir", std::process::id()));
+    let d = scratch("fit-hold-tir");
+    let path = d.path().join("fitted.tir");
     t.write(&path).unwrap();
     let tyre = Tyre::from_file(&path).unwrap();
-    let _ = std::fs::remove_file(&path);
     let x = MfInput {
         fz: t.get("FNOMIN").unwrap(),
         alpha: 0.04,
@@ -164,7 +163,9 @@ fn unknown_hold_key_is_an_error_naming_it() {
 /// an unknown key fails the command with a message naming it.
 #[test]
 fn cli_hold_option() {
-    let (dir, rec) = rig_file("cli");
+    let tmp = scratch("fit-hold-cli");
+    let dir = tmp.path();
+    let rec = rig_file(dir);
     let out = dir.join("fitted.tir");
     let run = |hold: &str| {
         let o = std::process::Command::new(env!("CARGO_BIN_EXE_tyrekit"))
@@ -187,5 +188,4 @@ fn cli_hold_option() {
     assert_ne!(fitted.get("PCY1"), start.get("PCY1"));
     let (ok, err) = run("PDY1,PXY7");
     assert!(!ok && err.contains("PXY7"), "{err}");
-    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -52,9 +52,8 @@ fn round_trip(file: &str, seed: u64) {
     }
     let truth_p = TyreParams::from_file(&path).unwrap();
     let truth = Tyre::new(truth_p.clone()).unwrap();
-    let tmp = std::env::temp_dir().join(format!("tyrekit_fit_mf_rt_{}_{seed}", std::process::id()));
-    std::fs::create_dir_all(&tmp).unwrap();
-    let rec = recording(&truth, seed, &tmp);
+    let tmp = common::scratch(&format!("fit-mf-rt-{seed}"));
+    let rec = recording(&truth, seed, tmp.path());
     let opts = MfFitOptions {
         only: vec![StageKind::PureFx, StageKind::PureFy],
         nominal_from_data: false,
@@ -202,7 +201,6 @@ fn round_trip(file: &str, seed: u64) {
             "{file}: {name} fitted {f}, truth {t}"
         );
     }
-    let _ = std::fs::remove_dir_all(&tmp);
 }
 
 #[test]

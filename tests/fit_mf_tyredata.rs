@@ -48,10 +48,10 @@ fn tyredata_fy_mz_fit_and_tir_reload() {
     );
 
     // Report plots.
-    let dir = std::env::temp_dir().join(format!("tyrekit_fit_mf_td_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = common::scratch("fit-mf-td");
+    let dir = tmp.path();
     let fitted = Tyre::new(res.tyre.clone()).unwrap();
-    let plots = tyrekit::fit::plot::plot_fit(&fitted, &recs[0], &opts.only, &dir).unwrap();
+    let plots = tyrekit::fit::plot::plot_fit(&fitted, &recs[0], &opts.only, dir).unwrap();
     assert!(
         plots.len() >= 2,
         "expected plots of Fy and Mz per condition"
@@ -87,7 +87,6 @@ fn tyredata_fy_mz_fit_and_tir_reload() {
             assert_eq!(fitted.forces(&x, mode), t2.forces(&x, mode));
         }
     }
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// The same real test with its wheel-speed, effective-radius and slip-ratio
@@ -126,9 +125,8 @@ fn tyredata_without_wheel_speed_fits_as_free_rolling() {
         cut.push('\n');
         cut.push_str(&pick(l));
     }
-    let dir = std::env::temp_dir().join(format!("tyrekit_fit_mf_td_now_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join("TyreData_no_wheel_speed.csv");
+    let tmp = common::scratch("fit-mf-td-now");
+    let p = tmp.path().join("TyreData_no_wheel_speed.csv");
     std::fs::write(&p, cut).unwrap();
     let loaded = tyrekit::data::load(&p, &tyrekit::data::LoadOptions::default()).unwrap();
     assert!(

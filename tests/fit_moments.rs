@@ -56,12 +56,13 @@ fn mx_and_my_round_trip_from_rig_data() {
     cfg.programme.pressures.truncate(1);
     cfg.programme.warmup = None;
     let run = simulate(&cfg, &mut SteadyMf::new(tt.clone()));
-    let dir = std::env::temp_dir().join(format!("tyrekit_fit_moments_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let mat = dir.join("rig.mat");
-    run.write_mat(&mat, true).unwrap();
-    let mut rec = Recording::from_file(&mat).unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
+    // Read back whole: the folder goes at the block's end.
+    let mut rec = {
+        let dir = common::scratch("fit-moments");
+        let mat = dir.path().join("rig.mat");
+        run.write_mat(&mat, true).unwrap();
+        Recording::from_file(&mat).unwrap()
+    };
     assert!(rec.has("Mx") && !rec.has("My"), "TTC carries MX, not MY");
     // My from the truth at the recorded conditions, with 0.2 N·m noise
     // (a deterministic pseudo-random sequence), as a CSV would carry it.

@@ -5,6 +5,7 @@
 //! geometry keys carry their `$` marks. Runs the binary on TyreData.csv
 //! (skips with a message when ../shared is absent).
 
+use crate::common::scratch;
 use sha2::{Digest, Sha256};
 use std::path::Path;
 use std::process::Command;
@@ -17,8 +18,8 @@ fn fitted_file_names_its_origin() {
         eprintln!("SKIP: {TYREDATA} not found (the shared data are not at hand)");
         return;
     }
-    let dir = std::env::temp_dir().join(format!("tyrekit-prov-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("prov");
+    let dir = tmp.path();
     let out = dir.join("fitted.tir");
     let rep = dir.join("report");
     let o = Command::new(env!("CARGO_BIN_EXE_tyrekit"))

@@ -5,6 +5,7 @@
 //! back near the truth's; a steady truth → the lag is reported as not
 //! identified and the start keys are kept.
 
+use crate::common::scratch;
 use tyrekit::data::Recording;
 use tyrekit::fit::transient::{fit_relaxation, nominal_sigma};
 use tyrekit::mf::{Forces, Tyre, UseMode};
@@ -86,13 +87,11 @@ fn config(truth: &Tyre) -> RigConfig {
 fn recording(truth: &TyreParams, model: &mut dyn TruthModel) -> Recording {
     let t = Tyre::new(truth.clone()).unwrap();
     let run = simulate(&config(&t), model);
-    let dir = std::env::temp_dir().join(format!("tyrekit_fit_transient_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(format!("{}.mat", model.describe().len()));
+    // The file is read back whole here, so its folder ends with this call.
+    let d = scratch("fit-transient");
+    let path = d.path().join(format!("{}.mat", model.describe().len()));
     run.write_mat(&path, true).unwrap();
-    let rec = Recording::from_file(&path).unwrap();
-    let _ = std::fs::remove_file(&path);
-    rec
+    Recording::from_file(&path).unwrap()
 }
 
 /// The truth: the built-in tyre with carcass stiffnesses that make its

@@ -16,8 +16,14 @@ use tyrekit::fmi::vars::vr;
 
 #[test]
 fn step_path_does_not_allocate() {
-    let dir = std::env::temp_dir().join(format!("tyrekit-alloc-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    // `common::scratch` spelled out (in the allocation binary, tests/alloc.rs,
+    // `common` is a private module of transient_alloc): a fresh folder,
+    // removed when `tmp` drops.
+    let tmp = tempfile::Builder::new()
+        .prefix("tyrekit-alloc-")
+        .tempdir()
+        .unwrap();
+    let dir = tmp.path();
     tyrekit::tir::TyreParams::builtin()
         .write(&dir.join("tyre.tir"))
         .unwrap();
@@ -29,9 +35,8 @@ fn step_path_does_not_allocate() {
         ("relaxation", true),
         ("lugre", false),
     ] {
-        steps_without_allocation(&dir, kind, nonlinear);
+        steps_without_allocation(dir, kind, nonlinear);
     }
-    let _ = std::fs::remove_dir_all(dir);
 }
 
 fn steps_without_allocation(dir: &std::path::Path, kind: &str, nonlinear: bool) {

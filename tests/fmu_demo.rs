@@ -3,6 +3,7 @@
 //! (|Fx| < 2 % of Fz with untouched start values, the bound), and its
 //! workflow part must write report.html and name the concealed effect.
 
+use crate::common::scratch;
 use std::process::Command;
 
 /// The number after `key` in `line` (`key` followed by the value and a space).
@@ -21,13 +22,12 @@ fn number_after(line: &str, key: &str) -> f64 {
 #[test]
 fn demo_runs_free_rolling_then_finds_the_concealed_effect() {
     // Outside the source tree (CARGO_TARGET_TMPDIR is inside it), as a user.
-    let dir = std::env::temp_dir().join(format!("tyrekit-demo-test-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let tmp = scratch("demo-test");
+    let dir = tmp.path();
     let t0 = std::time::Instant::now();
     let o = Command::new(env!("CARGO_BIN_EXE_tyrekit"))
         .args(["demo", "--threads", "2"])
-        .current_dir(&dir)
+        .current_dir(dir)
         .output()
         .expect("running tyrekit demo");
     let secs = t0.elapsed().as_secs_f64();
@@ -73,5 +73,4 @@ fn demo_runs_free_rolling_then_finds_the_concealed_effect() {
         verdict.starts_with("verdict: relaxation (concealed: relaxation)"),
         "{verdict}"
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }

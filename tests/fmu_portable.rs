@@ -125,10 +125,10 @@ fn installed_tool_packages_from_an_empty_directory() {
         .expect("running cargo install");
     assert!(st.success(), "cargo install failed");
     // Outside the source tree (target/ is inside it): the system's temp dir.
-    let empty = std::env::temp_dir().join(format!("tyrekit-portable-empty-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&empty);
-    std::fs::create_dir_all(&empty).unwrap();
-    let fmu = package(&root.join("bin").join("tyrekit"), &empty, None);
+    // (`crate::common::scratch`, not this file's `scratch` under target/.)
+    let tmp = crate::common::scratch("portable-empty");
+    let empty = tmp.path();
+    let fmu = package(&root.join("bin").join("tyrekit"), empty, None);
     assert_eq!(
         fmu,
         empty.join("TyreKit.fmu"),
@@ -180,5 +180,4 @@ fn installed_tool_packages_from_an_empty_directory() {
         y[1]
     );
     drop(inst);
-    let _ = std::fs::remove_dir_all(&empty);
 }

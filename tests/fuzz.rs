@@ -16,6 +16,7 @@
 //! synthesises from the Magic Formula and writes with the crate's writers)
 //! plus the shared `.tir` files when present.
 
+use crate::common::scratch;
 use crate::tir_common;
 
 use rand::{Rng, SeedableRng};
@@ -475,8 +476,8 @@ fn fuzz_fmu_calls() {
     use tyrekit::fmi::exports::*;
     use tyrekit::fmi::types::{Fmi2Status, FMI2_CO_SIMULATION};
     use tyrekit::fmi::vars::vr;
-    let dir = std::env::temp_dir().join(format!("tyrekit-fuzz-fmu-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let d = scratch("fuzz-fmu");
+    let dir = d.path();
     TyreParams::builtin().write(&dir.join("tyre.tir")).unwrap();
     let r0 = TyreParams::builtin().p.unloaded_radius;
     let name = CString::new("fuzz").unwrap();
@@ -651,5 +652,4 @@ fn fuzz_fmu_calls() {
         result
     });
     eprintln!("fuzz fmu: {n} sequences, {steps_ok} accepted steps checked");
-    let _ = std::fs::remove_dir_all(dir);
 }

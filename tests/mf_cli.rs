@@ -2,7 +2,7 @@
 //! columns) writes MFeval's 30 columns that match the reference.
 
 use crate::common;
-use common::{num, shared};
+use common::{num, scratch, shared};
 use std::process::Command;
 
 #[test]
@@ -14,7 +14,8 @@ fn eval_reproduces_a_reference_csv() {
         println!("SKIPPED: shared reference data absent");
         return;
     }
-    let out = std::env::temp_dir().join(format!("tyrekit-eval-test-{}.csv", std::process::id()));
+    let d = scratch("eval-test");
+    let out = d.path().join("eval-test.csv");
     let st = Command::new(env!("CARGO_BIN_EXE_tyrekit"))
         .args(["eval", "--tir"])
         .arg(&tir)
@@ -31,7 +32,6 @@ fn eval_reproduces_a_reference_csv() {
         String::from_utf8_lossy(&st.stderr)
     );
     let ours = std::fs::read_to_string(&out).unwrap();
-    let _ = std::fs::remove_file(&out);
     let theirs = std::fs::read_to_string(&reference).unwrap();
     let mut ol = ours.lines();
     let header: Vec<&str> = ol.next().unwrap().split(',').collect();
@@ -68,8 +68,8 @@ fn eval_reproduces_a_reference_csv() {
 
 #[test]
 fn eval_reports_bad_input_with_file_line_and_column() {
-    let dir = std::env::temp_dir().join(format!("tyrekit-eval-bad-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let d = scratch("eval-bad");
+    let dir = d.path();
     let input = dir.join("in.csv");
     std::fs::write(
         &input,
@@ -84,7 +84,6 @@ fn eval_reports_bad_input_with_file_line_and_column() {
         .output()
         .unwrap();
     let msg = String::from_utf8_lossy(&st.stderr).to_string();
-    let _ = std::fs::remove_dir_all(&dir);
     assert!(!st.status.success());
     assert!(
         msg.contains("in.csv") && msg.contains("line 3") && msg.contains("alpha"),

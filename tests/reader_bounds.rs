@@ -4,6 +4,7 @@
 //! within MEMORY_BOUND, and nothing may crash (stack overflow = SIGABRT).
 //! The figures are printed (`--nocapture`) and stated in the README.
 
+use crate::common::scratch;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -11,15 +12,10 @@ use std::process::Command;
 const MEMORY_BOUND: u64 = 1 << 30;
 const MB50: usize = 50 << 20;
 
-fn dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("tyrekit-bounds-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// Run `tyrekit ARGS`; (exit code, peak RSS bytes, stderr).
-fn run(args: &[&str]) -> (i32, u64, String) {
-    let err = dir().join("stderr.txt");
+/// Run `tyrekit ARGS`, its stderr kept in the test's folder `d`; (exit code,
+/// peak RSS bytes, stderr).
+fn run(d: &Path, args: &[&str]) -> (i32, u64, String) {
+    let err = d.join("stderr.txt");
     let child = Command::new(env!("CARGO_BIN_EXE_tyrekit"))
         .args(args)
         .stdout(std::process::Stdio::null())
@@ -45,8 +41,8 @@ fn run(args: &[&str]) -> (i32, u64, String) {
     )
 }
 
-fn check(what: &str, args: &[&str], must_fail: bool) -> u64 {
-    let (code, rss, err) = run(args);
+fn check(d: &Path, what: &str, args: &[&str], must_fail: bool) -> u64 {
+    let (code, rss, err) = run(d, args);
     eprintln!(
         "{what}: exit {code}, peak RSS {} MiB; {}",
         rss >> 20,
@@ -66,8 +62,8 @@ fn check(what: &str, args: &[&str], must_fail: bool) -> u64 {
     rss
 }
 
-fn write(name: &str, bytes: &[u8]) -> PathBuf {
-    let p = dir().join(name);
+fn write(d: &Path, name: &str, bytes: &[u8]) -> PathBuf {
+    let p = d.join(name);
     std::fs::write(&p, bytes).unwrap();
     p
 }
@@ -107,6 +103,8 @@ fn matrix(class: u8, inner: &[u8]) -> Vec<u8> {
 
 #[test]
 fn mat_nested_10000_deep_is_an_error_not_a_stack_overflow() {
+    let tmp = scratch("bounds");
+    let d = tmp.path();
     let mut el = {
         let mut d = Vec::new();
         tag(&mut d, 9, 8);
@@ -124,14 +122,21 @@ fn mat_nested_10000_deep_is_an_error_not_a_stack_overflow() {
     tag(&mut f, 15, zb.len());
     f.extend(zb);
     eprintln!("nested .mat: {} bytes", f.len());
-    let p = write("nested.mat", &f);
-    check("mat nested 10000 deep", &["data", "summary", s(&p)], true);
-    let (_, _, err) = run(&["data", "summary", s(&p)]);
+    let p = write(d, "nested.mat", &f);
+    check(
+        d,
+        "mat nested 10000 deep",
+        &["data", "summary", s(&p)],
+        true,
+    );
+    let (_, _, err) = run(d, &["data", "summary", s(&p)]);
     assert!(err.contains("nested"), "{err}");
 }
 
 #[test]
 fn mat_decompression_bomb_is_refused_early() {
+    let tmp = scratch("bounds");
+    let d = tmp.path();
     // A double array declared as 1.2e8 values (960 MB), zeros, compressed: ~1 MB.
     let n: usize = 120_000_000;
     let mut inner = Vec::new();
@@ -164,25 +169,29 @@ fn mat_decompression_bomb_is_refused_early() {
         f.len(),
         (n * 8) >> 20
     );
-    let p = write("bomb.mat", &f);
-    let rss = check("mat bomb", &["data", "summary", s(&p)], true);
+    let p = write(d, "bomb.mat", &f);
+    let rss = check(d, "mat bomb", &["data", "summary", s(&p)], true);
     // Refused at 64 x the file size: far below the 960 MB it declares.
     assert!(rss < 400 << 20, "bomb took {} MiB", rss >> 20);
 }
 
 #[test]
 fn tir_of_50mb_duplicated_keys() {
+    let tmp = scratch("bounds");
+    let d = tmp.path();
     let mut t = b"[MODEL]\nFITTYP = 61\n".to_vec();
     while t.len() < MB50 {
         t.extend_from_slice(b"PDX1 = 1\nXKEY = 2\n");
     }
-    let p = write("dup.tir", &t);
+    let p = write(d, "dup.tir", &t);
     let input = write(
+        d,
         "in.csv",
         b"Fz,kappa,alpha,gamma,phit,Vx,P,omega\n4000,0,0,0,0,10,,\n",
     );
-    let out = dir().join("out.csv");
+    let out = d.join("out.csv");
     check(
+        d,
         "tir 50 MB duplicated keys",
         &[
             "eval",
@@ -213,45 +222,53 @@ fn tir_of_50mb_duplicated_keys() {
     assert!(secs < 10.0, "{secs} s");
 }
 
-fn numbers_file(name: &str, head: &str, line: &str) -> PathBuf {
+fn numbers_file(d: &Path, name: &str, head: &str, line: &str) -> PathBuf {
     let mut t = head.as_bytes().to_vec();
     while t.len() < MB50 {
         t.extend_from_slice(line.as_bytes());
     }
-    write(name, &t)
+    write(d, name, &t)
 }
 
 #[test]
 fn recordings_of_50mb() {
+    let tmp = scratch("bounds");
+    let d = tmp.path();
     let csv = numbers_file(
+        d,
         "big.csv",
         "time,Vx,omega,Fz,kappa,alpha,gamma,phit,P,Fx,Fy,Mx,My,Mz\n",
         "0,1,2,3,0,0,0,0,1,2,3,4,5,6\n",
     );
-    check("csv 50 MB", &["data", "summary", s(&csv)], false);
+    check(d, "csv 50 MB", &["data", "summary", s(&csv)], false);
     let garbage = numbers_file(
+        d,
         "garbage.csv",
         "a,b\n",
         "1,2,3,4,5,6,7,8,9,0,1,2,3,4,5,6,7\n",
     );
     check(
+        d,
         "csv 50 MB ragged rows",
         &["data", "summary", s(&garbage)],
         true,
     );
     let dat = numbers_file(
+        d,
         "big.dat",
         "ET V N SA IA RL RE P FX FY FZ MX MZ SR\ns kph rpm deg deg cm cm kPa N N N N-m N-m none\n",
         "0 40 300 1 0 30 31 80 10 20 -1000 1 2 0\n",
     );
-    check("dat 50 MB", &["data", "summary", s(&dat)], false);
+    check(d, "dat 50 MB", &["data", "summary", s(&dat)], false);
     let tdx = numbers_file(
+        d,
         "big.tdx",
         "**HEADER\nRELEASE 1.3\n**MEASURCHANNELS\nRUNTIME  time  s  1 0\nLONGVEL  Vx  m/s 1 0\nFZW  Fz  N 1 0\n**MEASURDATA\n",
         "0 10 4000\n",
     );
     // 5 million rows of 10 bytes: refused by the row limit.
     check(
+        d,
         "tdx 50 MB (5.2 M short rows)",
         &["data", "summary", s(&tdx)],
         true,
@@ -284,6 +301,6 @@ fn recordings_of_50mb() {
             .collect(),
         ..Default::default()
     };
-    let mat = write("big.mat", &tyrekit::data::ttc::write_mat(&t, false));
-    check("mat 50 MB", &["data", "summary", s(&mat)], false);
+    let mat = write(d, "big.mat", &tyrekit::data::ttc::write_mat(&t, false));
+    check(d, "mat 50 MB", &["data", "summary", s(&mat)], false);
 }

@@ -3,9 +3,10 @@
 //! reason, doubtful ones load with a warning — through the library
 //! (`Tyre::from_file`, what the CLI and the FMU call) and the `eval` command.
 
+use crate::common::scratch;
 use crate::tir_common;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use tir_common::{file_name, tir_files};
 use tyrekit::mf::{MfInput, Tyre, UseMode};
 use tyrekit::tir::BUILTIN_TIR;
@@ -28,16 +29,18 @@ fn variant(key: &str, line: &str) -> String {
     out.join("\n")
 }
 
-fn write(name: &str, text: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("tyrekit-validation-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+/// `text` written to `dir/name`.
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     let p = dir.join(name);
     std::fs::write(&p, text).unwrap();
     p
 }
 
+/// The built-in file with `key`'s line replaced, written and loaded (the file
+/// is read whole here, so its folder ends with this call).
 fn load(key: &str, line: &str) -> Result<Tyre, String> {
-    let p = write(&format!("{key}.tir"), &variant(key, line));
+    let d = scratch("validation");
+    let p = write(d.path(), &format!("{key}.tir"), &variant(key, line));
     Tyre::from_file(&p).map_err(|e| e.to_string())
 }
 
@@ -191,13 +194,15 @@ fn absurd_coefficients_load_with_a_warning() {
     }
 }
 
-/// `tyrekit eval --tir TIR` on one input row: (success, stderr).
-fn eval(tir: &std::path::Path) -> (bool, String) {
+/// `tyrekit eval --tir TIR` on one input row (its input and output files in
+/// `dir`): (success, stderr).
+fn eval(dir: &Path, tir: &Path) -> (bool, String) {
     let input = write(
+        dir,
         "in.csv",
         "Fz,kappa,alpha,gamma,phit,Vx,P,omega\n4000,0,0.05,0,0,16.7,,\n",
     );
-    let out = write("out.csv", "");
+    let out = write(dir, "out.csv", "");
     let r = std::process::Command::new(env!("CARGO_BIN_EXE_tyrekit"))
         .args(["eval", "--tir"])
         .arg(tir)
@@ -217,9 +222,11 @@ fn eval(tir: &std::path::Path) -> (bool, String) {
 /// refuses what the library refuses (same function).
 #[test]
 fn eval_prints_warnings_and_refuses() {
-    let (ok, err) = eval(&write("doubt.tir", &variant("QSX1", "QSX1 = 1e6")));
+    let tmp = scratch("validation");
+    let d = tmp.path();
+    let (ok, err) = eval(d, &write(d, "doubt.tir", &variant("QSX1", "QSX1 = 1e6")));
     assert!(ok, "{err}");
     assert!(err.contains("validation: Mx"), "stderr: {err}");
-    let (ok, err) = eval(&write("bad.tir", &variant("FNOMIN", "FNOMIN = 0")));
+    let (ok, err) = eval(d, &write(d, "bad.tir", &variant("FNOMIN", "FNOMIN = 0")));
     assert!(!ok && err.contains("FNOMIN"), "stderr: {err}");
 }

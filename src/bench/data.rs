@@ -27,8 +27,8 @@ pub fn run(ctx: &super::BenchContext) -> Result<()> {
     let mut big = RigConfig::standard(&tyre, 2);
     big.sample_rate = 100.0 * target / run.rows() as f64;
     let r = simulate(&big, &mut SteadyMf::new(tyre));
-    let dir = std::env::temp_dir().join(format!("tyrekit-bench-data-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+    let scratch = super::ScratchDir::new("data")?;
+    let dir = scratch.path();
     let mat = dir.join("big.mat");
     let dat = dir.join("big.dat");
     r.write_mat(&mat, true)?;
@@ -54,6 +54,5 @@ pub fn run(ctx: &super::BenchContext) -> Result<()> {
             l.recording.segments.len()
         );
     }
-    let _ = std::fs::remove_dir_all(&dir);
     Ok(())
 }

@@ -35,8 +35,8 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
     let mut truth = effects::concealed("relaxation", tyre.clone(), 1.0)
         .ok_or_else(|| crate::Error::Other("no relaxation effect".into()))?;
     let run = simulate(&cfg, truth.as_mut());
-    let dir = std::env::temp_dir().join(format!("tyrekit-bench-diag-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).map_err(|e| crate::Error::io(&dir, e))?;
+    let scratch = super::ScratchDir::new("diag")?;
+    let dir = scratch.path();
     let path = dir.join("rig.mat");
     run.write_mat(&path, false)?;
     let rec = crate::data::Recording::from_file(&path)?;
@@ -96,9 +96,9 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
     let d = case.diagnose(threads, &mut |_| {})?.diagnosis;
     let t_diag = t0.elapsed().as_secs_f64();
     let t0 = Instant::now();
-    let pl = plots::draw_all(rec, &d, &dir)?;
+    let pl = plots::draw_all(rec, &d, dir)?;
     let page = html::page(&d, &pl, &rec.source, "");
-    std::fs::write(dir.join("report.html"), page).map_err(|e| crate::Error::io(&dir, e))?;
+    std::fs::write(dir.join("report.html"), page).map_err(|e| crate::Error::io(dir, e))?;
     let t_plot = t0.elapsed().as_secs_f64();
     let total = t_all.elapsed().as_secs_f64();
     let json = d.json();
@@ -116,6 +116,5 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
         per150k(total),
         per150k(total - t_fit)
     );
-    let _ = std::fs::remove_dir_all(&dir);
     Ok(())
 }

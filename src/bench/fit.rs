@@ -217,9 +217,9 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
     let nfree = params.iter().filter(|p| p.free).count();
     println!("[fit] pure-Fy Magic Formula (MF 6.1, {nfree} parameters), {n} samples (1 % noise), start = a moved tyre");
     let form = form_of(start.version);
-    let dir = std::env::temp_dir().join(format!("tyrekit_bench_fit_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).map_err(|e| crate::Error::io(&dir, e))?;
-    write_inputs(&dir, &data, &start, &truth_p, &params)?;
+    let scratch = super::ScratchDir::new("fit")?;
+    let dir = scratch.path();
+    write_inputs(dir, &data, &start, &truth_p, &params)?;
     // The options `tyrekit fit` uses (coarse subsample first, then all samples).
     let opts = crate::fit::mf_fit::MfFitOptions::default().fit;
     let repeats = if ctx.quick { 1 } else { 3 };
@@ -285,7 +285,7 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
         }
     }
     let out = out.ok_or_else(|| crate::Error::Other("bench fit: no run".into()))?;
-    match run_python(ctx, &dir) {
+    match run_python(ctx, dir) {
         Ok(rs) => {
             for r in rs {
                 println!(
@@ -302,9 +302,7 @@ pub fn run(ctx: &super::BenchContext) -> crate::Result<()> {
         }
         Err(e) => println!("  SciPy: skipped: {e}"),
     }
-    let r = whole_fit(ctx, &dir);
-    let _ = std::fs::remove_dir_all(&dir);
-    r
+    whole_fit(ctx, dir)
 }
 
 /// The whole staged fit `tyrekit fit` runs by default (pure Fx, pure Fy,

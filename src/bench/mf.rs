@@ -301,14 +301,15 @@ fn python_peers(ctx: &BenchContext, tyre: &Tyre, mode: UseMode, inp: &[MfInput],
         );
         return;
     }
-    let dir = std::env::temp_dir().join(format!("tyrekit-bench-mf-{}", std::process::id()));
-    if let Err(e) = std::fs::create_dir_all(&dir) {
-        println!(
-            "[mf] skipped: Python peers (cannot create {}: {e})",
-            dir.display()
-        );
-        return;
-    }
+    let scratch = match super::ScratchDir::new("mf") {
+        Ok(s) => s,
+        Err(e) => {
+            // `e` reads "PATH: reason", as this message always did.
+            println!("[mf] skipped: Python peers (cannot create {e})");
+            return;
+        }
+    };
+    let dir = scratch.path();
     let p = &tyre.params().p;
     let params: serde_json::Map<String, serde_json::Value> = PY_KEYS
         .iter()
@@ -339,7 +340,6 @@ fn python_peers(ctx: &BenchContext, tyre: &Tyre, mode: UseMode, inp: &[MfInput],
         .arg(&ic)
         .arg(if ctx.quick { "3" } else { "7" })
         .output();
-    let _ = std::fs::remove_dir_all(&dir);
     let out = match out {
         Ok(o) => o,
         Err(e) => {

@@ -20,6 +20,33 @@ pub struct BenchContext {
     pub quick: bool,
 }
 
+/// A section's scratch folder, `temp_dir()/tyrekit-bench-{tag}-{pid}`, removed
+/// with everything in it when dropped: at the section's end, also when it
+/// returns early with an error or panics. (The test's `tempfile` is a
+/// dev-dependency only, so the binary has this one.)
+pub(crate) struct ScratchDir(std::path::PathBuf);
+
+impl ScratchDir {
+    /// Create the folder; failing that, the crate's I/O error naming it.
+    pub(crate) fn new(tag: &str) -> crate::Result<Self> {
+        let dir = std::env::temp_dir().join(format!("tyrekit-bench-{tag}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).map_err(|e| crate::Error::io(&dir, e))?;
+        Ok(Self(dir))
+    }
+
+    /// The folder.
+    pub(crate) fn path(&self) -> &std::path::Path {
+        &self.0
+    }
+}
+
+impl Drop for ScratchDir {
+    fn drop(&mut self) {
+        // Nothing to do about a folder that cannot be removed.
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
 /// A benchmark section: (name, runner).
 pub type Section = (&'static str, fn(&BenchContext) -> crate::Result<()>);
 

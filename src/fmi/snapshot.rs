@@ -265,25 +265,28 @@ mod tests {
     use super::*;
     use crate::fmi::logging::Logger;
 
-    fn instance() -> (Box<Instance>, std::path::PathBuf) {
-        let dir = std::env::temp_dir().join(format!(
-            "tyrekit-snapshot-{}-{:?}",
-            std::process::id(),
-            std::thread::current().id()
-        ));
-        std::fs::create_dir_all(&dir).unwrap();
+    /// An instance of the built-in tyre and its resources folder (removed
+    /// when the guard drops).
+    fn instance() -> (Box<Instance>, tempfile::TempDir) {
+        let dir = tempfile::Builder::new()
+            .prefix("tyrekit-snapshot-")
+            .tempdir()
+            .unwrap();
         crate::tir::TyreParams::builtin()
-            .write(&dir.join("tyre.tir"))
+            .write(&dir.path().join("tyre.tir"))
             .unwrap();
-        let inst = Instance::new(Logger::new(None, "t", false), Some(dir.to_str().unwrap()))
-            .map_err(|(_, e)| e)
-            .unwrap();
+        let inst = Instance::new(
+            Logger::new(None, "t", false),
+            Some(dir.path().to_str().unwrap()),
+        )
+        .map_err(|(_, e)| e)
+        .unwrap();
         (inst, dir)
     }
 
     #[test]
     fn round_trip_is_exact() {
-        let (mut inst, dir) = instance();
+        let (mut inst, _dir) = instance();
         inst.sim.phase = Phase::StepComplete;
         inst.sim.values.reals[crate::fmi::vars::real::VY] = 0.7;
         inst.do_step(0.0, 1e-3).unwrap();
@@ -295,12 +298,11 @@ mod tests {
         assert_eq!(back.time, inst.sim.time);
         assert_eq!(back.phase, inst.sim.phase);
         assert_eq!(serialize(&back), bytes);
-        let _ = std::fs::remove_dir_all(dir);
     }
 
     #[test]
     fn every_truncation_and_byte_flip_is_refused() {
-        let (inst, dir) = instance();
+        let (inst, _dir) = instance();
         let bytes = serialize(&inst.sim);
         for n in 0..bytes.len() {
             assert!(deserialize(&inst, &bytes[..n]).is_err(), "truncated to {n}");
@@ -310,6 +312,5 @@ mod tests {
             b[i] ^= 0x5a;
             assert!(deserialize(&inst, &b).is_err(), "byte {i} flipped");
         }
-        let _ = std::fs::remove_dir_all(dir);
     }
 }

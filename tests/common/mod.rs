@@ -1,5 +1,6 @@
-//! Helpers shared by the integration tests: the shared-data path, reference
-//! CSV reading, and the transient tests' models, inputs and expectations.
+//! Helpers shared by the integration tests: the shared-data path, per-test
+//! scratch folders, reference CSV reading, and the transient tests' models,
+//! inputs and expectations.
 #![allow(dead_code, unused_imports)]
 
 use std::path::{Path, PathBuf};
@@ -12,6 +13,28 @@ pub fn shared() -> PathBuf {
         Some(s) if !p.exists() => PathBuf::from(s),
         _ => p,
     }
+}
+
+/// A test's scratch folder: a fresh `tyrekit-{tag}-XXXXXX` under the system
+/// temp dir, removed (with everything in it) when the returned guard drops —
+/// at the end of the test, also when the test panics. Bind the guard to a
+/// named variable (`let d = scratch("…");`, never `_`) that lives until the
+/// last use of its files, and use `d.path()`.
+///
+/// With the environment variable `TYREKIT_KEEP` set (to anything) the folder
+/// is kept instead and its path printed to stderr, for looking at a test's
+/// outputs afterwards.
+pub fn scratch(tag: &str) -> tempfile::TempDir {
+    let prefix = format!("tyrekit-{tag}-");
+    let mut d = tempfile::Builder::new()
+        .prefix(&prefix)
+        .tempdir()
+        .unwrap_or_else(|e| panic!("scratch folder {prefix}*: {e}"));
+    if std::env::var_os("TYREKIT_KEEP").is_some() {
+        d.disable_cleanup(true);
+        eprintln!("kept {}", d.path().display());
+    }
+    d
 }
 
 /// A CSV number with MATLAB/Octave's NaN/Inf spelling.

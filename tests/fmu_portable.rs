@@ -42,7 +42,9 @@ fn entry(fmu: &Path, name: &str) -> Vec<u8> {
     b
 }
 
-fn scratch(name: &str) -> PathBuf {
+/// A fixed folder under cargo's target/tmp, emptied at each use (bounded:
+/// one per name, not one per run).
+fn target_scratch(name: &str) -> PathBuf {
     let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("portable-{name}"));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
@@ -70,7 +72,7 @@ fn max_glibc(so: &Path) -> (u32, u32) {
 
 #[test]
 fn packaged_library_needs_at_most_the_glibc_floor_and_is_stripped() {
-    let dir = scratch("glibc");
+    let dir = target_scratch("glibc");
     let fmu = package(
         Path::new(env!("CARGO_BIN_EXE_tyrekit")),
         &dir,
@@ -110,7 +112,7 @@ fn packaged_library_needs_at_most_the_glibc_floor_and_is_stripped() {
 /// of the build machine in it, and loadable by an independent importer.
 #[test]
 fn installed_tool_packages_from_an_empty_directory() {
-    let root = scratch("install");
+    let root = target_scratch("install");
     let target = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
         .parent()
         .unwrap()
@@ -125,7 +127,6 @@ fn installed_tool_packages_from_an_empty_directory() {
         .expect("running cargo install");
     assert!(st.success(), "cargo install failed");
     // Outside the source tree (target/ is inside it): the system's temp dir.
-    // (`crate::common::scratch`, not this file's `scratch` under target/.)
     let tmp = crate::common::scratch("portable-empty");
     let empty = tmp.path();
     let fmu = package(&root.join("bin").join("tyrekit"), empty, None);

@@ -6,7 +6,7 @@
 //! Skips (with a message) when ../shared is absent.
 
 use crate::common::scratch;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 const TYREDATA: &str = "../shared/data/measurements/TyreData.csv";
@@ -16,10 +16,6 @@ fn bin() -> Command {
 }
 
 /// `name` in the test's scratch folder `d`.
-fn tmp(d: &Path, name: &str) -> PathBuf {
-    d.join(name)
-}
-
 fn shared() -> Option<String> {
     match std::fs::read_to_string(TYREDATA) {
         Ok(s) => Some(s),
@@ -96,10 +92,10 @@ fn s(p: &Path) -> &str {
 fn sae_signs_read_as_iso_stop_every_command() {
     let d = scratch("misuse");
     let Some(text) = shared() else { return };
-    let p = tmp(d.path(), "sae.csv");
+    let p = d.path().join("sae.csv");
     std::fs::write(&p, sae(&text)).unwrap();
-    let out = tmp(d.path(), "sae.tir");
-    let rep = tmp(d.path(), "sae_report");
+    let out = d.path().join("sae.tir");
+    let rep = d.path().join("sae_report");
     let needles = ["Fz < 0", "--axes sae"];
     assert_fails(&["fit", s(&p), "--out", s(&out), "--only", "fy"], &needles);
     assert!(!out.exists(), "a .tir was written");
@@ -111,7 +107,7 @@ fn sae_signs_read_as_iso_stop_every_command() {
             "--tir",
             "src/tir/builtin.tir",
             "--out",
-            s(&tmp(d.path(), "sae_sim.csv")),
+            s(&d.path().join("sae_sim.csv")),
         ],
         &needles,
     );
@@ -122,9 +118,9 @@ fn sae_signs_read_as_iso_stop_every_command() {
 fn sae_file_with_axes_sae_fits() {
     let d = scratch("misuse");
     let Some(text) = shared() else { return };
-    let p = tmp(d.path(), "sae_ok.csv");
+    let p = d.path().join("sae_ok.csv");
     std::fs::write(&p, sae(&text)).unwrap();
-    let out = tmp(d.path(), "sae_ok.tir");
+    let out = d.path().join("sae_ok.tir");
     let (ok, err) = run(&[
         "fit",
         s(&p),
@@ -144,11 +140,11 @@ fn degrees_in_a_radian_column_stop_fit_and_diagnose() {
     let d = scratch("misuse");
     let Some(text) = shared() else { return };
     let deg = 180.0 / std::f64::consts::PI;
-    let p = tmp(d.path(), "deg.csv");
+    let p = d.path().join("deg.csv");
     // SA values in degrees, the header still says [rad].
     std::fs::write(&p, rewrite(&text, |h| h.to_string(), &[("SA", deg)])).unwrap();
     let needles = ["degrees", "alpha", "SA [deg]"];
-    let out = tmp(d.path(), "deg.tir");
+    let out = d.path().join("deg.tir");
     assert_fails(&["fit", s(&p), "--out", s(&out), "--only", "fy"], &needles);
     assert!(!out.exists());
     assert_fails(
@@ -156,7 +152,7 @@ fn degrees_in_a_radian_column_stop_fit_and_diagnose() {
             "diagnose",
             s(&p),
             "--report",
-            s(&tmp(d.path(), "deg_report")),
+            s(&d.path().join("deg_report")),
         ],
         &needles,
     );
@@ -167,7 +163,7 @@ fn no_usable_stage_is_an_error_not_a_written_file() {
     let d = scratch("misuse");
     // A recording with load and speed but no force or moment channel: every
     // stage is skipped, so nothing may be written and the exit is non-zero.
-    let p = tmp(d.path(), "noforce.csv");
+    let p = d.path().join("noforce.csv");
     let mut t = String::from("time,Vx,omega,Fz,alpha,gamma\n");
     for i in 0..400 {
         let a = 0.2 * ((i as f64) * 0.05).sin();
@@ -180,7 +176,7 @@ fn no_usable_stage_is_an_error_not_a_written_file() {
         ));
     }
     std::fs::write(&p, t).unwrap();
-    let out = tmp(d.path(), "noforce.tir");
+    let out = d.path().join("noforce.tir");
     assert_fails(
         &["fit", s(&p), "--out", s(&out)],
         &["no stage had usable data"],
@@ -191,7 +187,7 @@ fn no_usable_stage_is_an_error_not_a_written_file() {
             "diagnose",
             s(&p),
             "--report",
-            s(&tmp(d.path(), "noforce_report")),
+            s(&d.path().join("noforce_report")),
         ],
         &["cannot be analysed"],
     );
@@ -204,7 +200,7 @@ fn a_drive_brake_run_without_any_slip_says_why_no_stage_fits() {
     // no slip channel: κ cannot be known and free rolling cannot be
     // assumed. The error must name the missing slip, not only count zero
     // samples in segments that are plainly there.
-    let p = tmp(d.path(), "noslip.csv");
+    let p = d.path().join("noslip.csv");
     let mut t = String::from("time,Vx,Fz,alpha,gamma,Fx,Fy\n");
     for i in 0..2000 {
         let x = ((i as f64) * 0.01).sin();
@@ -216,7 +212,7 @@ fn a_drive_brake_run_without_any_slip_says_why_no_stage_fits() {
         ));
     }
     std::fs::write(&p, t).unwrap();
-    let out = tmp(d.path(), "noslip.tir");
+    let out = d.path().join("noslip.tir");
     assert_fails(
         &["fit", s(&p), "--out", s(&out)],
         &["no slip ratio κ", "data summary"],

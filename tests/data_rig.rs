@@ -9,10 +9,6 @@ use tyrekit::mf::Tyre;
 use tyrekit::rig::{simulate, Noise, RigConfig, RigRun, SteadyMf, TtcUnits};
 
 /// `name` in the test's scratch folder `d`.
-fn tmp(d: &Path, name: &str) -> PathBuf {
-    d.join(name)
-}
-
 fn run(units: TtcUnits, seed: u64) -> (RigConfig, RigRun) {
     let tyre = Tyre::builtin();
     let mut cfg = RigConfig::standard(&tyre, seed);
@@ -217,8 +213,8 @@ fn rig_mat_and_dat_recover_the_iso_truth() {
     assert!(n_checked > 1000);
     // The built-in tyre's ISO Fy opposes α (PKY1 < 0 in ISO): a positive SAE
     // SA therefore gives a positive ISO Fy after reading.
-    let pm = tmp(d.path(), "rig.mat");
-    let pd = tmp(d.path(), "rig.dat");
+    let pm = d.path().join("rig.mat");
+    let pd = d.path().join("rig.dat");
     r.write_mat(&pm, true).unwrap();
     r.write_dat(&pd).unwrap();
     for p in [&pm, &pd] {
@@ -244,7 +240,7 @@ fn rig_mat_and_dat_recover_the_iso_truth() {
 fn kappa_from_wheel_speed_and_the_disturbed_recorded_re() {
     let d = scratch("data-rig");
     let (_, r) = run(TtcUnits::Si, 11);
-    let p = tmp(d.path(), "kappa.mat");
+    let p = d.path().join("kappa.mat");
     r.write_mat(&p, false).unwrap();
     // Free-rolling Re(Fz): κ within noise of the imposed κ. Noise on Ω
     // (0.02 rad/s of ~37 rad/s) and V (0.02 of 11.1 m/s) gives σκ ≈ 0.0018.
@@ -308,7 +304,7 @@ fn us_customary_export_reads_to_the_same_si_values() {
         .map(|c| c.unit.as_deref().unwrap())
         .collect();
     assert!(units.contains(&"lb") && units.contains(&"psi") && units.contains(&"mph"));
-    let p = tmp(d.path(), "us.dat");
+    let p = d.path().join("us.dat");
     r.write_dat(&p).unwrap();
     let l = read(&p, ReChoice::FreeRolling);
     check_recovery(&l.recording, &r, &cfg);
@@ -330,7 +326,7 @@ fn rig_is_reproducible_and_noise_free_run_is_exact() {
     cfg.programme.db_alphas.clear();
     cfg.decimate = 4;
     let r = simulate(&cfg, &mut SteadyMf::new(tyre));
-    let p = tmp(d.path(), "exact.mat");
+    let p = d.path().join("exact.mat");
     r.write_mat(&p, true).unwrap();
     let l = load(
         &p,
@@ -360,7 +356,7 @@ fn warmup_at_its_own_load_is_cut_as_an_irregular_segment() {
     }
     cfg.decimate = 2;
     let r = simulate(&cfg, &mut SteadyMf::new(tyre));
-    let p = tmp(d.path(), "warm.mat");
+    let p = d.path().join("warm.mat");
     r.write_mat(&p, true).unwrap();
     let l = read(&p, ReChoice::FreeRolling);
     let w = l.report.warmup.as_ref().expect("warm-up detected");
@@ -412,7 +408,7 @@ fn structure_survives_other_tyres_noise_and_rates() {
             *x *= 2.0;
         }
         let r = simulate(&cfg, &mut SteadyMf::new(tyre));
-        let p = tmp(d.path(), &format!("robust-{name}.mat"));
+        let p = d.path().join(format!("robust-{name}.mat"));
         r.write_mat(&p, true).unwrap();
         let l = read(&p, ReChoice::FreeRolling);
         assert_eq!(l.recording.segments.len(), r.plan.len(), "{name}");

@@ -7,16 +7,11 @@
 //! and every sweep found as pure lateral (not `combined`).
 
 use crate::common::scratch;
-use std::path::{Path, PathBuf};
 use tyrekit::data::{load, LoadOptions, Loaded, Recording, SegmentKind};
 use tyrekit::mf::Tyre;
 use tyrekit::rig::{simulate, RigConfig, RigRun, SteadyMf, TtcUnits};
 
 /// `name` in the test's scratch folder `d`.
-fn tmp(d: &Path, name: &str) -> PathBuf {
-    d.join(name)
-}
-
 /// A cornering-only TTC programme (no drive/brake runs): three loads, two
 /// inclinations, one pressure, no warm-up (kept short).
 fn cornering_run(units: TtcUnits) -> RigRun {
@@ -124,8 +119,8 @@ fn ttc_dead_wheel_speed_dat_and_mat_si_and_us() {
             .count();
         assert!(plan_lateral >= 6, "the programme has {plan_lateral} sweeps");
         kill_wheel_speed(&mut run);
-        let dat = tmp(d.path(), &format!("dead_{units:?}.dat"));
-        let mat = tmp(d.path(), &format!("dead_{units:?}.mat"));
+        let dat = d.path().join(format!("dead_{units:?}.dat"));
+        let mat = d.path().join(format!("dead_{units:?}.mat"));
         run.write_dat(&dat).unwrap();
         run.write_mat(&mat, true).unwrap();
         for p in [&dat, &mat] {
@@ -155,7 +150,7 @@ fn healthy_ttc_cornering_keeps_its_channels() {
     let d = scratch("data-sanity");
     // Control: the same export with a working wheel speed loses nothing.
     let run = cornering_run(TtcUnits::Si);
-    let p = tmp(d.path(), "healthy.dat");
+    let p = d.path().join("healthy.dat");
     run.write_dat(&p).unwrap();
     let l = read(&p);
     assert!(l.report.rejected.is_empty(), "{:?}", l.report.rejected);
@@ -184,7 +179,7 @@ fn absurd_moment_channel_loses_the_channel_not_the_rows() {
             *x = 9.9e5;
         }
     }
-    let p = tmp(d.path(), "absurd_mx.dat");
+    let p = d.path().join("absurd_mx.dat");
     run.write_dat(&p).unwrap();
     let l = read(&p);
     assert!(rejected(&l, "Mx"), "{:?}", l.report.rejected);
@@ -199,7 +194,7 @@ fn absurd_moment_channel_loses_the_channel_not_the_rows() {
 fn tydex_dead_wheel_speed_and_pinned_slip() {
     let d = scratch("data-sanity");
     let run = cornering_run(TtcUnits::Si);
-    let p = tmp(d.path(), "healthy_for_tdx.dat");
+    let p = d.path().join("healthy_for_tdx.dat");
     run.write_dat(&p).unwrap();
     let mut rec = read(&p).recording;
     let plan_lateral = count(&rec, SegmentKind::PureLateral);
@@ -210,7 +205,7 @@ fn tydex_dead_wheel_speed_and_pinned_slip() {
     }
     rec.extra
         .retain(|(n, _)| n != "Re" && n != "SR" && n != "SL");
-    let tdx = tmp(d.path(), "dead.tdx");
+    let tdx = d.path().join("dead.tdx");
     std::fs::write(&tdx, tyrekit::data::tdx::write(&rec)).unwrap();
     let l = read(&tdx);
     assert!(rejected(&l, "kappa"), "{:?}", l.report.rejected);
@@ -247,7 +242,7 @@ fn a_force_channel_that_does_not_follow_its_slip_is_rejected() {
     let mut kn_fy = run;
     col(&mut kn_fy, "FY").iter_mut().for_each(|x| *x /= 1000.0);
     for (r, dead, live) in [(dead_fx, "Fx", "Fy"), (kn_fy, "Fy", "Fx")] {
-        let p = tmp(d.path(), &format!("dead_{dead}.dat"));
+        let p = d.path().join(format!("dead_{dead}.dat"));
         r.write_dat(&p).unwrap();
         let l = read(&p);
         assert!(
@@ -286,7 +281,9 @@ fn a_moment_channel_that_does_not_follow_the_lateral_force_is_rejected() {
     let mut knm = run.clone();
     col(&mut knm, "MZ").iter_mut().for_each(|x| *x /= 1000.0);
     for (r, what) in [(dead, "dead"), (knm, "kN m")] {
-        let p = tmp(d.path(), &format!("dead_mz_{}.dat", what.replace(' ', "_")));
+        let p = d
+            .path()
+            .join(format!("dead_mz_{}.dat", what.replace(' ', "_")));
         r.write_dat(&p).unwrap();
         let l = read(&p);
         assert!(
@@ -303,7 +300,7 @@ fn a_moment_channel_that_does_not_follow_the_lateral_force_is_rejected() {
         );
         assert_eq!(l.report.dropped_total, 0, "{:?}", l.report.dropped);
     }
-    let p = tmp(d.path(), "live_mz.dat");
+    let p = d.path().join("live_mz.dat");
     run.write_dat(&p).unwrap();
     let l = read(&p);
     assert!(l.report.rejected.is_empty(), "{:?}", l.report.rejected);
@@ -340,7 +337,7 @@ fn force_channels_of_a_tyre_on_ice_are_kept() {
     ice.set("LMUX", 0.06).unwrap();
     ice.set("LMUY", 0.06).unwrap();
     for (t, what) in [(Tyre::new(ice).unwrap(), "ice"), (Tyre::builtin(), "dry")] {
-        let p = tmp(d.path(), &format!("forces_{what}.dat"));
+        let p = d.path().join(format!("forces_{what}.dat"));
         full_run(&t, 12).write_dat(&p).unwrap();
         let l = read(&p);
         assert!(

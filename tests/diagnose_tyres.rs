@@ -61,18 +61,48 @@ const TYRES: [(&str, &str); 8] = [
     ),
 ];
 
-/// A control recording of `tyre`: the rig's standard programme at one
-/// pressure, inclinations 0 and 2°, drive/brake at two slip angles.
-fn control(tyre: &Tyre, seed: u64, path: &Path) {
+/// A recording of `tyre` with `effect` concealed at `level` (its second
+/// formulation where the rig has one when `alt`) at `path`: the rig's
+/// standard programme at one pressure (all three for `pressure`), cornering
+/// at `inclinations`, drive/brake at two slip angles.
+fn record(
+    tyre: &Tyre,
+    effect: &str,
+    level: f64,
+    alt: bool,
+    inclinations: Vec<f64>,
+    seed: u64,
+    path: &Path,
+) {
     let mut c = RigConfig::standard(tyre, seed);
     let pr = &mut c.programme;
-    pr.pressures = vec![pr.pressures[1]];
-    pr.inclinations = vec![0.0, 2f64.to_radians()];
+    if effect != "pressure" {
+        pr.pressures = vec![pr.pressures[1]];
+    }
+    pr.inclinations = inclinations;
     pr.db_alphas.truncate(2);
-    let mut truth = effects::concealed("none", tyre.clone(), 1.0).expect("control");
+    let mut truth = alt
+        .then(|| effects::concealed_alt(effect, tyre.clone(), level))
+        .flatten()
+        .or_else(|| effects::concealed(effect, tyre.clone(), level))
+        .expect("a rig effect");
     simulate(&c, truth.as_mut())
         .write_mat(path, true)
         .expect("write .mat");
+}
+
+/// A control recording of `tyre`: [`record`] without an effect, cornering
+/// at 0 and 2°.
+fn control(tyre: &Tyre, seed: u64, path: &Path) {
+    record(
+        tyre,
+        "none",
+        1.0,
+        false,
+        vec![0.0, 2f64.to_radians()],
+        seed,
+        path,
+    );
 }
 
 /// `tyrekit diagnose REC --report DIR` as a user runs it (no `--tir`) on
@@ -179,4 +209,95 @@ fn a_recording_whose_forces_follow_no_slip_names_nothing() {
         );
     }
     assert_eq!(d["verdict"], "none", "{}", d["explanation"]);
+}
+
+/// Tyres of the effects probe: (file, why). None of them made the dev set.
+const EFFECT_TYRES: [(&str, &str); 4] = [
+    ("MagicFormula62_Parameters.tir", "MF 6.2 car tyre"),
+    ("Sedan_Pac02Tire.tir", "PAC2002 car tyre"),
+    ("HoosierR20.tir", "MF 6.1 FSAE tyre"),
+    (
+        "335_65R22_5_G275MSA_60psi.tir",
+        "truck tyre, FNOMIN 21.7 kN",
+    ),
+];
+
+/// The physics the dev set conceals, each at the rig's level 2 (its second
+/// formulation where it has one — a compound softening with temperature,
+/// an exponential speed law, a power law in load — so the formulas differ
+/// from the proof's first ones).
+const PROBE_EFFECTS: [&str; 7] = [
+    "none",
+    "relaxation",
+    "thermal",
+    "load_sensitivity",
+    "pressure",
+    "speed_friction",
+    "rolling_radius",
+];
+
+/// Effects concealed in rig recordings of four tyres the dev set did not
+/// use, each diagnosed as a user runs it (no `--tir`: the baseline is
+/// fitted from the built-in tyre). Asserted: no wrong name (a verdict is the
+/// concealed effect or `none`, whose words may say the baseline misfits),
+/// the controls `none`; printed: the verdict table and how many were named.
+///
+/// The programme is the rig's at one belt speed and pressure (three for
+/// `pressure`), cornering upright, drive/brake at two slip angles. Two
+/// effects cannot be told from the baseline here, so `none` is the right
+/// answer for them, not a miss: at one belt speed the sliding speed is the
+/// slip times a constant, so a friction falling with it is a slip-curve
+/// shape the fitted Magic Formula holds; the rig's rolling-radius error
+/// (κ' = (1 + κ)(1 + a·dfz) − 1) is a load-proportional slip shift, which
+/// PHX2 holds. Cornering is upright because inclination blocks run in time
+/// order (0° then 2°, as in many TTC runs) let the baseline's camber terms
+/// take up a tread temperature rising through the run, and the thermal
+/// candidate, screened against that baseline, then loses on the held-out
+/// inclination (3 Dec 2026: thermal named on 0 of 4 tyres that way, held-out
+/// Fy 5–69 % worse) — a known limit written in the README.
+///
+/// On demand: the rig is the project's own, so this is the fit's and the
+/// candidates' reach over other tyres, not the diagnosis's generality (the
+/// dev set's job). `TYREKIT_PROBE_FILTER=name` runs the effects whose name
+/// contains it.
+#[test]
+#[ignore = "on demand (28 recordings through the whole diagnosis, ≈ 260 s on 2 cores)"]
+fn effects_on_other_tyres_get_no_wrong_name() {
+    let tir = common::shared().join("data/tir");
+    if !tir.exists() {
+        eprintln!("SKIP effects_on_other_tyres_get_no_wrong_name: ../shared/data/tir is absent");
+        return;
+    }
+    let tmp = common::scratch("diag-tyre-effects");
+    let dir = tmp.path();
+    let filter = std::env::var("TYREKIT_PROBE_FILTER").unwrap_or_default();
+    let mut wrong = Vec::new();
+    let mut named = 0;
+    for (k, (file, why)) in EFFECT_TYRES.iter().enumerate() {
+        let tyre = Tyre::from_file(&tir.join(file)).expect("a shared tyre file");
+        for (e, effect) in PROBE_EFFECTS.iter().enumerate() {
+            if !filter.is_empty() && !effect.contains(filter.as_str()) {
+                continue;
+            }
+            let rec = dir.join(format!("t{k}_{effect}.mat"));
+            let seed = 300 + 10 * k as u64 + e as u64;
+            record(&tyre, effect, 2.0, true, vec![0.0], seed, &rec);
+            let report = dir.join(format!("t{k}_{effect}"));
+            let (_, d) = diagnose(file, &rec, &report);
+            let verdict = d["verdict"].as_str().unwrap_or("?").to_string();
+            println!("{file} ({why}) | {effect} | {verdict}");
+            if verdict == *effect && *effect != "none" {
+                named += 1;
+            }
+            let allowed = verdict == *effect || (*effect != "none" && verdict == "none");
+            if !allowed {
+                wrong.push(format!("{file} {effect}: {verdict}: {}", d["explanation"]));
+            }
+        }
+    }
+    println!(
+        "named {named} of {}",
+        EFFECT_TYRES.len() * (PROBE_EFFECTS.len() - 1)
+    );
+    assert!(wrong.is_empty(), "wrong names: {wrong:#?}");
 }

@@ -253,8 +253,10 @@ const PROBE_EFFECTS: [&str; 7] = [
 /// order (0° then 2°, as in many TTC runs) let the baseline's camber terms
 /// take up a tread temperature rising through the run, and the thermal
 /// candidate, screened against that baseline, then loses on the held-out
-/// inclination (3 Dec 2026: thermal named on 0 of 4 tyres that way, held-out
-/// Fy 5–69 % worse) — a known limit written in the README.
+/// inclination (3 Dec 2026, before the candidate fitted the Fx level:
+/// thermal named on 0 of 4 tyres that way, held-out Fy 5–69 % worse; the
+/// MF 6.2 tyre's recording after it: `none` too) — a known limit written in
+/// the README.
 ///
 /// On demand: the rig is the project's own, so this is the fit's and the
 /// candidates' reach over other tyres, not the diagnosis's generality (the

@@ -294,6 +294,19 @@ fn real_tyre_data_end_to_end() {
             assert!(e["parameters"][k].is_null(), "{} fits {k}", e["name"]);
         }
     }
+    // No word describes a value nobody computed: a candidate that acts
+    // only on Fx has nothing to fit here, a slip region without samples has
+    // no mean, and neither may print as "NaN" in the words or the page.
+    let page = std::fs::read_to_string(rep.join("report.html")).unwrap();
+    let text = std::fs::read_to_string(rep.join("diagnosis.json")).unwrap();
+    for (what, s) in [("report.html", &page), ("diagnosis.json", &text)] {
+        let at = s.find("NaN");
+        assert!(
+            at.is_none(),
+            "{what} prints NaN: …{}…",
+            &s[at.unwrap().saturating_sub(200)..at.unwrap()]
+        );
+    }
     // The recorded Mz lags the slip angle by 0.125 s while Fy does not
     // (the best delay of a per-sweep curve, `fit_validity`'s
     // `tyredata_mz_lags_the_slip_angle_which_no_steady_model_can_follow`):

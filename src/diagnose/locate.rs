@@ -671,10 +671,22 @@ pub fn locate(d: &Residuals, o: &LocateOptions) -> Vec<Finding> {
             "slip_region",
             &w.u,
             &|y| region_r2(y, &w.region),
-            format!(
-                "mean signed residual (+ = measured stronger): linear {:+.3}, peak {:+.3}, sliding {:+.3}",
-                region_means[0], region_means[1], region_means[2]
-            ),
+            {
+                // A region without samples has no mean: say so.
+                let m = |k: usize| {
+                    if region_means[k].is_finite() {
+                        format!("{:+.3}", region_means[k])
+                    } else {
+                        "no samples".to_string()
+                    }
+                };
+                format!(
+                    "mean signed residual (+ = measured stronger): linear {}, peak {}, sliding {}",
+                    m(0),
+                    m(1),
+                    m(2)
+                )
+            },
             &mut rng,
         );
         if w.dir.iter().any(|&x| x != 0.0) {

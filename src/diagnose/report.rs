@@ -435,6 +435,9 @@ pub fn diagnose_with(
                 },
                 if e.name == "none" {
                     String::new()
+                } else if e.n_params == 0 {
+                    // Nothing was fitted: no values to describe.
+                    format!("{}: not fitted; ", e.physics)
                 } else {
                     format!("{}: {}; ", e.physics, e.describe)
                 },
@@ -445,9 +448,9 @@ pub fn diagnose_with(
                     String::new()
                 } else {
                     match (why_not(e), overshadowed_in_words(&ev, i)) {
-                        (Some(w), _) => format!(". Not named: {w}"),
-                        (None, Some(w)) => format!(". Qualifies, but is not named: {w}"),
-                        (None, None) => ". Qualifies as a verdict".to_string(),
+                        (Some(w), _) => format!(". Not named: {w}."),
+                        (None, Some(w)) => format!(". Qualifies, but is not named: {w}."),
+                        (None, None) => ". Qualifies as a verdict.".to_string(),
                     }
                 },
                 at_bound_note(e)

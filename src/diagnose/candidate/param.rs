@@ -649,7 +649,11 @@ impl Candidate for ParamCandidate {
     }
     fn describe(&self, f: &dyn Fitted) -> String {
         let held = f.held();
-        if held.is_empty() {
+        if f.parameters().is_empty() {
+            // The fit fell back to the baseline (nothing applicable):
+            // no value to describe.
+            "not fitted".to_string()
+        } else if held.is_empty() {
             (self.words)(f)
         } else {
             format!(

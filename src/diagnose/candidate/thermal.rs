@@ -23,7 +23,8 @@
 //! rig recordings of a compound softening with temperature (tanh curve) on
 //! four tyres the dev set does not use — with both levels held, the fit
 //! traded Fx against Fy (Fx 1 % off on every drive/brake run, held-out Fx
-//! 27–42 % worse) and the effect went unnamed on all four. The
+//! 9–26 % worse with upright cornering) and the effect went unnamed on all
+//! four; with LMUX free it is named on two. The
 //! re-estimation beneath a finding then fits the MF's own friction keys
 //! under the curve.
 //!
@@ -110,13 +111,20 @@ pub(super) fn candidate() -> ParamCandidate {
             let m = |x: f64| {
                 100.0 * (param(f, "MU_T0") + param(f, "MU_T1") * x + param(f, "MU_T2") * x * x)
             };
+            // LMUX is fitted only where the fit half has Fx; otherwise it
+            // is not among the fitted values and is not described.
+            let lmux = param(f, "LMUX");
+            let level = if lmux.is_finite() {
+                format!("; Fx friction scale LMUX {lmux:.3} (the baseline's Fx level, held at the drive/brake runs' temperature)")
+            } else {
+                String::new()
+            };
             format!(
-                "a tread heat capacity of {c:.0} J/K (time constant {:.0} s with {h:.1} W/K cooling); friction {:+.1} % at ambient, {:+.1} % at +25 K, {:+.1} % at +50 K; Fx friction scale LMUX {:.3}",
+                "a tread heat capacity of {c:.0} J/K (time constant {:.0} s with {h:.1} W/K cooling); friction {:+.1} % at ambient, {:+.1} % at +25 K, {:+.1} % at +50 K{level}",
                 c / h,
                 m(0.0),
                 m(0.5),
                 m(1.0),
-                param(f, "LMUX")
             )
         },
         reestimation: Reestimation::ThroughScales,

@@ -427,3 +427,54 @@ fn structure_survives_other_tyres_noise_and_rates() {
         let _ = std::fs::remove_file(&p);
     }
 }
+
+/// A speed programme (drive/brake blocks at 32, 40 and 48 km/h, as tyre
+/// tests run them): every drive/brake segment is found at its own belt
+/// speed, in the programme's order, and the cornering stays at `speed`.
+#[test]
+fn drive_brake_blocks_at_several_belt_speeds_are_found_at_their_speeds() {
+    let d = scratch("data-rig");
+    let tyre = Tyre::builtin();
+    let mut cfg = RigConfig::standard(&tyre, 31);
+    let pr = &mut cfg.programme;
+    pr.pressures.truncate(1);
+    pr.inclinations.truncate(1);
+    pr.loads.truncate(2);
+    pr.db_alphas.truncate(1);
+    let kph = [32.0, 40.0, 48.0];
+    pr.db_speeds = kph.iter().map(|v| v / 3.6).collect();
+    let r = simulate(&cfg, &mut SteadyMf::new(tyre));
+    let p = d.path().join("speeds.mat");
+    r.write_mat(&p, true).unwrap();
+    let l = read(&p, ReChoice::FreeRolling);
+    let segs = &l.recording.segments;
+    assert_eq!(segs.len(), r.plan.len());
+    let long: Vec<f64> = segs
+        .iter()
+        .filter(|s| s.kind == SegmentKind::PureLongitudinal)
+        .map(|s| s.vx * 3.6)
+        .collect();
+    // Two loads per speed; belt-speed noise 0.05 m/s, so the median of a
+    // segment is within a few mm/s of its set point: 0.2 km/h is ample and
+    // far below the 8 km/h step between speeds.
+    assert_eq!(long.len(), 6, "{long:?}");
+    for (i, v) in long.iter().enumerate() {
+        assert!((v - kph[i / 2]).abs() < 0.2, "segment {i}: {v} km/h");
+    }
+    for s in segs.iter().filter(|s| s.kind == SegmentKind::PureLateral) {
+        assert!(
+            (s.vx * 3.6 - 40.0).abs() < 0.2,
+            "cornering at {} km/h",
+            s.vx * 3.6
+        );
+    }
+    // The truth follows the belt: Vx of every drive/brake row (α = 0) is
+    // its segment's set point exactly.
+    for q in r
+        .plan
+        .iter()
+        .filter(|q| q.kind == SegmentKind::PureLongitudinal)
+    {
+        assert!(r.truth[q.start..q.end].iter().all(|s| s.vx == q.vx));
+    }
+}

@@ -162,7 +162,8 @@ pub struct Programme {
     pub inclinations: Vec<f64>,
     /// Loads (N), inner loop.
     pub loads: Vec<f64>,
-    /// Belt speed (m/s).
+    /// Belt speed (m/s) of the cornering runs, and of the drive/brake runs
+    /// when `db_speeds` is empty.
     pub speed: f64,
     /// Cornering sweep turning points (ISO α, rad), from and back to 0.
     pub lateral_points: Vec<f64>,
@@ -172,6 +173,10 @@ pub struct Programme {
     pub db_alphas: Vec<f64>,
     /// Inclinations of the drive/brake runs (rad).
     pub db_inclinations: Vec<f64>,
+    /// Belt speeds of the drive/brake runs (m/s), an outer loop inside each
+    /// pressure, as a tyre test's speed programme runs its drive/brake
+    /// blocks at several speeds; empty: `speed` alone.
+    pub db_speeds: Vec<f64>,
     /// Slip-ratio sweep amplitude A (–): 0 → +A → −A → 0.
     pub db_kappa: f64,
     /// Slip-ratio sweep rate (1/s).
@@ -205,6 +210,7 @@ impl Programme {
             alpha_rate: d(4.0),
             db_alphas: vec![0.0, d(3.0), d(6.0)],
             db_inclinations: vec![0.0],
+            db_speeds: Vec::new(),
             db_kappa: 0.2,
             kappa_rate: 0.1,
             transition: 1.5,
@@ -377,6 +383,8 @@ struct SetPoint {
     gamma: f64,
     p: f64,
     alpha: f64,
+    /// Belt speed (m/s).
+    v: f64,
 }
 
 fn lerp(a: f64, b: f64, t: f64) -> f64 {
@@ -466,10 +474,12 @@ pub fn simulate(cfg: &RigConfig, model: &mut dyn TruthModel) -> RigRun {
         gamma: pr.inclinations.first().copied().unwrap_or(0.0),
         p: pr.pressures.first().copied().unwrap_or(2e5),
         alpha: 0.0,
+        v: pr.speed,
     };
     // Lead-in: tyre unloaded for 1 s, then loaded.
     cur.p = first.p;
     cur.gamma = first.gamma;
+    cur.v = pr.speed;
     steps.push(Step::Transition {
         from: cur,
         to: cur,
@@ -497,6 +507,7 @@ pub fn simulate(cfg: &RigConfig, model: &mut dyn TruthModel) -> RigRun {
                     gamma: g,
                     p,
                     alpha: 0.0,
+                    v: pr.speed,
                 };
                 if sp != cur {
                     goto(&mut steps, &mut cur, sp, pr.transition);
@@ -510,22 +521,30 @@ pub fn simulate(cfg: &RigConfig, model: &mut dyn TruthModel) -> RigRun {
             }
         }
     }
+    let db_speeds = if pr.db_speeds.is_empty() {
+        std::slice::from_ref(&pr.speed)
+    } else {
+        &pr.db_speeds[..]
+    };
     for &p in &pr.pressures {
-        for &g in &pr.db_inclinations {
-            for &a in &pr.db_alphas {
-                for &fz in &pr.loads {
-                    let sp = SetPoint {
-                        fz,
-                        gamma: g,
-                        p,
-                        alpha: a,
-                    };
-                    goto(&mut steps, &mut cur, sp, pr.transition);
-                    steps.push(Step::DriveBrake {
-                        sp,
-                        amp: pr.db_kappa,
-                        rate: pr.kappa_rate,
-                    });
+        for &v in db_speeds {
+            for &g in &pr.db_inclinations {
+                for &a in &pr.db_alphas {
+                    for &fz in &pr.loads {
+                        let sp = SetPoint {
+                            fz,
+                            gamma: g,
+                            p,
+                            alpha: a,
+                            v,
+                        };
+                        goto(&mut steps, &mut cur, sp, pr.transition);
+                        steps.push(Step::DriveBrake {
+                            sp,
+                            amp: pr.db_kappa,
+                            rate: pr.kappa_rate,
+                        });
+                    }
                 }
             }
         }
@@ -595,6 +614,7 @@ pub fn simulate(cfg: &RigConfig, model: &mut dyn TruthModel) -> RigRun {
                             gamma: lerp(from.gamma, to.gamma, s),
                             p: lerp(from.p, to.p, s),
                             alpha: lerp(from.alpha, to.alpha, s),
+                            v: lerp(from.v, to.v, s),
                         },
                         lerp(from.alpha, to.alpha, s),
                         0.0,
@@ -615,7 +635,7 @@ pub fn simulate(cfg: &RigConfig, model: &mut dyn TruthModel) -> RigRun {
             } else {
                 0.0
             };
-            let v = pr.speed;
+            let v = sp.v;
             let vx = v * alpha.cos();
             let mut inp = RigInput {
                 time: t,
@@ -748,7 +768,7 @@ pub fn simulate(cfg: &RigConfig, model: &mut dyn TruthModel) -> RigRun {
                     fz: sp.fz,
                     gamma: sp.gamma,
                     p: sp.p,
-                    vx: pr.speed,
+                    vx: sp.v,
                     alpha: if kind == SegmentKind::PureLateral {
                         f64::NAN
                     } else {

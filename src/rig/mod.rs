@@ -173,9 +173,10 @@ pub struct Programme {
     pub db_alphas: Vec<f64>,
     /// Inclinations of the drive/brake runs (rad).
     pub db_inclinations: Vec<f64>,
-    /// Belt speeds of the drive/brake runs (m/s), an outer loop inside each
-    /// pressure, as a tyre test's speed programme runs its drive/brake
-    /// blocks at several speeds; empty: `speed` alone.
+    /// Belt speeds of the drive/brake runs (m/s), a loop inside each slip
+    /// angle (the loads inside it), so the speeds come round again with
+    /// every slip angle instead of rising once through the run, as tyre
+    /// tests run their speed programmes; empty: `speed` alone.
     pub db_speeds: Vec<f64>,
     /// Slip-ratio sweep amplitude A (–): 0 → +A → −A → 0.
     pub db_kappa: f64,
@@ -527,9 +528,9 @@ pub fn simulate(cfg: &RigConfig, model: &mut dyn TruthModel) -> RigRun {
         &pr.db_speeds[..]
     };
     for &p in &pr.pressures {
-        for &v in db_speeds {
-            for &g in &pr.db_inclinations {
-                for &a in &pr.db_alphas {
+        for &g in &pr.db_inclinations {
+            for &a in &pr.db_alphas {
+                for &v in db_speeds {
                     for &fz in &pr.loads {
                         let sp = SetPoint {
                             fz,

@@ -279,8 +279,9 @@ const PROBE_EFFECTS: [(&str, bool); 8] = [
 /// contains it; `TYREKIT_PROBE_SPEEDS=all` records every effect in the
 /// speed programme (does a speed programme make another effect look like
 /// speed friction?) — it does, and fails (4 Dec 2026: thermal → speed
-/// friction on the PAC2002 and the Hoosier, rolling radius → thermal on
-/// MF 6.2; a known limit in the README).
+/// friction on the Hoosier, rolling radius → thermal on MF 6.2; the
+/// PAC2002's thermal → speed friction mended by the overshadow rule's
+/// second case; a known limit in the README).
 #[test]
 #[ignore = "on demand (32 recordings through the whole diagnosis, ≈ 320 s on 2 cores)"]
 fn effects_on_other_tyres_get_no_wrong_name() {

@@ -200,7 +200,11 @@ pub fn explain(
                     100.0 * b.oos_gain,
                     channels_in_words(b),
                     b.delta_bic,
-                    why_not(b).unwrap_or_default()
+                    // A qualifier is left unnamed only when another
+                    // candidate overshadows it, which a later sentence says.
+                    why_not(b).unwrap_or_else(|| {
+                        "another candidate removes more than twice as much of the same error (see below)".into()
+                    })
                 )
             });
             let nothing = if unseparable.is_some() {

@@ -278,10 +278,11 @@ const PROBE_EFFECTS: [(&str, bool); 8] = [
 /// dev set's job). `TYREKIT_PROBE_FILTER=name` runs the effects whose name
 /// contains it; `TYREKIT_PROBE_SPEEDS=all` records every effect in the
 /// speed programme (does a speed programme make another effect look like
-/// speed friction?) — it does, and fails (4 Dec 2026: thermal → speed
-/// friction on the Hoosier, rolling radius → thermal on MF 6.2; the
-/// PAC2002's thermal → speed friction mended by the overshadow rule's
-/// second case; a known limit in the README).
+/// speed friction?) — it did (4 Dec 2026: thermal → speed friction on the
+/// PAC2002 and the Hoosier, rolling radius → thermal on MF 6.2), mended by
+/// the overshadow rule's second case (the PAC2002) and by the thermal
+/// candidate's combined-slip weights scored against their reference (the
+/// other two; no wrong name in 32, thermal named on 4 of 4).
 #[test]
 #[ignore = "on demand (32 recordings through the whole diagnosis, ≈ 320 s on 2 cores)"]
 fn effects_on_other_tyres_get_no_wrong_name() {

@@ -96,6 +96,8 @@ mod diagnose_pressure;
 mod diagnose_proof;
 #[path = "diagnose_reestimate.rs"]
 mod diagnose_reestimate;
+#[path = "diagnose_reference.rs"]
+mod diagnose_reference;
 #[path = "diagnose_refit.rs"]
 mod diagnose_refit;
 #[path = "diagnose_replay.rs"]

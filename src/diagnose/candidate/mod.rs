@@ -11,7 +11,7 @@
 //! | `none` | – | the baseline |
 //! | `relaxation` | LONGITUDINAL_STIFFNESS, LATERAL_STIFFNESS (σ = K/C; LSGKP, LSGAL for MF 5.2/PAC2002) | LM, replayed transient |
 //! | `lugre` | `[LUGRE]` SIGMA0X, SIGMA0Y (bristle stiffness), MUS (Stribeck ratio) | LM, replayed transient |
-//! | `thermal` | `[THERMAL]` CAPACITY (time constant with COOLING = 40 W/K, SHARE = 0.5), MU_T0..2 | LM, replayed (tread-temperature state) |
+//! | `thermal` | `[THERMAL]` CAPACITY (time constant with COOLING ∝ Fz0, SHARE = 0.5), MU_T0..2; LMUX; LXAL, LYKA as a reference ([`Spec::reference`]) | LM, replayed (tread-temperature state) |
 //! | `load_sensitivity` | `[LOAD_SENSITIVITY]` FZ1..3 (knot loads from the fit half), MU_FZ1..3, K_FZ1..3 (natural splines of friction and slip stiffness over the load) | LM on a subsample (static), backward elimination ([`Spec::eliminate`]) |
 //! | `pressure` | PPX1, PPX3 (with Fx data), PPY1, PPY3 (with Fy/Mz data), PPZ1 (with Mz data) (MF 6.x only: MF 5.2/PAC2002 have no pressure terms; needs a recorded pressure that varies beyond its noise, [`crate::diagnose::factor`]) | LM, static (no elimination: on the proof's tvd3 pressure recordings it dropped terms worth 7 % of the gap) |
 //! | `speed_friction` | `[SPEED_FRICTION]` DMU, VC, VREF (s = g(Vs)/g(σ·VREF), g(v) = 1 − DMU·x/(1 + x), x = v/VC) | LM from two starts, static |
@@ -71,7 +71,8 @@
 //!   by more than [`MAX_LOSS`] (physics that is missing makes no channel
 //!   worse; a candidate that trades one channel for another absorbs a
 //!   misfit), and the pooled held-out and in-sample gains are positive;
-//!   among those the lowest pooled BIC wins, otherwise `none` — unless a
+//!   among those the lowest pooled BIC against the baseline itself wins
+//!   ([`Evaluation::rank_bic`]), otherwise `none` — unless a
 //!   candidate that does not qualify removes more than [`OVERSHADOW`] times
 //!   as much of the winner's evidence channel ([`overshadowed`]). The held-out
 //!   test keeps over-fitting out, the channel's BIC asks for evidence in
@@ -106,7 +107,7 @@ pub mod work;
 
 /// Index of Fx, Fy, Mz in [`crate::residual::Channel::SCORED`] (and in the weights).
 pub use crate::residual::{FX, FY, MZ};
-pub use param::{NoneCandidate, Param, ParamCandidate, Spec, Target, STATIC_SAMPLES};
+pub use param::{NoneCandidate, Param, ParamCandidate, ReferenceOf, Spec, Target, STATIC_SAMPLES};
 pub use selection::{
     also_qualifying, channels_in_words, overshadowed, overshadowed_in_words, overshadowed_summary,
     qualifies, select, why_not, MAX_LOSS, MIN_GAIN, OVERSHADOW,
@@ -191,6 +192,13 @@ pub trait Candidate: Send + Sync {
     /// ([`crate::diagnose::reestimate`]).
     fn reestimation(&self) -> Reestimation {
         Reestimation::No
+    }
+    /// What the candidate is scored against when it fits some of the
+    /// baseline's own keys again beside its parameters
+    /// ([`Spec::reference`]): the baseline with those keys alone fitted
+    /// again on the same half. None: the baseline itself.
+    fn reference(&self, _baseline: &Tyre, _opts: &ReplayOptions) -> Option<Box<dyn Candidate>> {
+        None
     }
     /// Whether the baseline can be fitted again beneath the extension at all.
     fn reestimable(&self) -> bool {

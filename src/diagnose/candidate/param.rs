@@ -300,6 +300,16 @@ pub struct Spec {
     /// drop them one at a time while that lowers the fit half's evidence
     /// statistic (`eliminate`), holding a dropped one at its start value.
     pub eliminate: bool,
+    /// Keys of the baseline's own Magic Formula that the candidate fits
+    /// again beside its parameters, because the baseline may have taken
+    /// up part of the effect through them (the thermal candidate: the
+    /// combined-slip weights, which absorb a temperature step between
+    /// drive/brake blocks run at one slip angle after another). They are
+    /// written to the extended file with the rest, but the candidate is
+    /// scored against the baseline with these keys alone fitted again on
+    /// the same half ([`ReferenceOf`], [`Candidate::reference`]), so that
+    /// the freedom they add never names the physics by itself.
+    pub reference: Vec<Param>,
 }
 
 /// Whether `get` varies beyond its noise over the segments overlapping `mask`.
@@ -618,6 +628,7 @@ fn eliminate(
 /// A candidate fitted by Levenberg–Marquardt (`fit_lm`) over the parameters of a
 /// [`Spec`] (built per baseline tyre; None: not applicable to that tyre, the
 /// fit is then the baseline itself).
+#[derive(Clone, Copy)]
 pub struct ParamCandidate {
     /// See [`Candidate::name`].
     pub name: &'static str,
@@ -663,6 +674,11 @@ impl Candidate for ParamCandidate {
             )
         }
     }
+    fn reference(&self, baseline: &Tyre, opts: &ReplayOptions) -> Option<Box<dyn Candidate>> {
+        (self.spec)(baseline, opts)
+            .filter(|s| !s.reference.is_empty())
+            .map(|_| Box::new(ReferenceOf(*self)) as Box<dyn Candidate>)
+    }
     fn fit(
         &self,
         rec: &Recording,
@@ -671,9 +687,59 @@ impl Candidate for ParamCandidate {
         mask: &[bool],
         w: &[f64; 3],
     ) -> Result<Box<dyn Fitted>> {
+        self.fit_part(rec, baseline, opts, mask, w, false)
+    }
+}
+
+/// The baseline with a candidate's [`Spec::reference`] keys alone fitted
+/// again (on the same half, with the same weights): what the candidate's
+/// gains are measured against ([`Candidate::reference`]). Never named.
+pub struct ReferenceOf(pub ParamCandidate);
+
+impl Candidate for ReferenceOf {
+    fn name(&self) -> &'static str {
+        "reference"
+    }
+    fn n_params(&self) -> usize {
+        0
+    }
+    fn fit(
+        &self,
+        rec: &Recording,
+        baseline: &Tyre,
+        opts: &ReplayOptions,
+        mask: &[bool],
+        w: &[f64; 3],
+    ) -> Result<Box<dyn Fitted>> {
+        self.0.fit_part(rec, baseline, opts, mask, w, true)
+    }
+}
+
+impl ParamCandidate {
+    /// [`Candidate::fit`] of the whole candidate (its parameters and its
+    /// [`Spec::reference`] keys), or with `reference_only` of the
+    /// reference keys alone on the baseline ([`ReferenceOf`]).
+    fn fit_part(
+        &self,
+        rec: &Recording,
+        baseline: &Tyre,
+        opts: &ReplayOptions,
+        mask: &[bool],
+        w: &[f64; 3],
+        reference_only: bool,
+    ) -> Result<Box<dyn Fitted>> {
         let Some(mut spec) = (self.spec)(baseline, opts) else {
             return NoneCandidate.fit(rec, baseline, opts, mask, w);
         };
+        if reference_only {
+            spec = Spec {
+                params: std::mem::take(&mut spec.reference),
+                ..Spec::default()
+            };
+        } else {
+            let reference = std::mem::take(&mut spec.reference);
+            spec.params.extend(reference);
+        }
         if let Some(f) = spec.from_data {
             match f(rec, mask) {
                 Some(v) => spec.fixed.extend(v),

@@ -87,7 +87,7 @@ pub fn select(ev: &[(Evaluation, Box<dyn Fitted>)]) -> Option<usize> {
     ev.iter()
         .enumerate()
         .filter(|&(i, (e, _))| qualifies(e) && overshadowed(ev, i).is_none())
-        .min_by(|a, b| a.1 .0.delta_bic.total_cmp(&b.1 .0.delta_bic))
+        .min_by(|a, b| a.1 .0.rank_bic.total_cmp(&b.1 .0.rank_bic))
         .map(|(i, _)| i)
 }
 
@@ -111,28 +111,35 @@ pub fn overshadowed(ev: &[(Evaluation, Box<dyn Fitted>)], i: usize) -> Option<(u
     q.channels.iter().find_map(|c| {
         ev.iter().enumerate().find_map(|(j, (e, _))| {
             let other = e.channels.iter().find(|o| o.channel == c.channel)?;
+            // What the other removes, with its reference's part (the
+            // baseline's own keys it fits again, `Spec::reference`): the
+            // structure it accounts for, against the same baseline as the
+            // qualifier's gain.
+            let removed = other.gain_over_baseline();
             let dwarfs = if shows(c) {
-                other.oos_gain > OVERSHADOW * c.oos_gain
+                removed > OVERSHADOW * c.oos_gain
             } else {
-                shows(other) && other.oos_gain > OVERSHADOW * c.oos_gain.max(MIN_GAIN)
+                shows(other) && removed > OVERSHADOW * c.oos_gain.max(MIN_GAIN)
             };
             (j != i
                 && e.name != "none"
                 && e.n_params > 0
                 && !qualifies(e)
-                && e.oos_gain > q.oos_gain
+                && e.gain_over_baseline() > q.oos_gain
                 && dwarfs)
                 .then_some((j, c.channel))
         })
     })
 }
 
-/// Held-out gain of `e` in channel `ch`, in per cent (NaN without data).
+/// Held-out gain of `e` in channel `ch` against the baseline, with its
+/// reference's part ([`ChannelScore::gain_over_baseline`]), in per cent
+/// (NaN without data).
 fn gain_in(e: &Evaluation, ch: Channel) -> f64 {
     e.channels
         .iter()
         .find(|c| c.channel == ch)
-        .map_or(f64::NAN, |c| 100.0 * c.oos_gain)
+        .map_or(f64::NAN, |c| 100.0 * c.gain_over_baseline())
 }
 
 /// Why qualifier `i` is not named though it qualifies ([`overshadowed`]),
@@ -206,7 +213,7 @@ pub fn also_qualifying(ev: &[(Evaluation, Box<dyn Fitted>)], winner: Option<usiz
     let mut v: Vec<usize> = (0..ev.len())
         .filter(|&i| Some(i) != winner && qualifies(&ev[i].0) && overshadowed(ev, i).is_none())
         .collect();
-    v.sort_by(|&a, &b| ev[a].0.delta_bic.total_cmp(&ev[b].0.delta_bic));
+    v.sort_by(|&a, &b| ev[a].0.rank_bic.total_cmp(&ev[b].0.rank_bic));
     v
 }
 
@@ -315,12 +322,15 @@ mod tests {
                     fit_gain: g,
                     delta_bic: b,
                     baseline_misfit: None,
+                    reference_gain: 0.0,
                 })
                 .collect(),
             parameters: vec![],
             at_bound: vec![],
             physics: String::new(),
             describe: String::new(),
+            reference_gain: 0.0,
+            rank_bic: bic,
         }
     }
 

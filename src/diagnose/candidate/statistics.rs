@@ -44,6 +44,18 @@ pub struct ChannelScore {
     /// for a verdict (see `selection`). Set by the diagnosis after the
     /// evaluation; None until then.
     pub baseline_misfit: Option<String>,
+    /// Held-out gain of the candidate's reference alone (the baseline with
+    /// the keys of [`super::Spec::reference`] fitted again) against the
+    /// baseline; 0 for a candidate scored against the baseline itself.
+    pub reference_gain: f64,
+}
+
+impl ChannelScore {
+    /// What the candidate removes of the baseline's held-out error with its
+    /// reference: 1 − (1 − [`ChannelScore::oos_gain`])·(1 − [`ChannelScore::reference_gain`]).
+    pub fn gain_over_baseline(&self) -> f64 {
+        1.0 - (1.0 - self.oos_gain) * (1.0 - self.reference_gain)
+    }
 }
 
 /// A candidate's evaluation.
@@ -72,9 +84,23 @@ pub struct Evaluation {
     pub physics: String,
     /// The fitted extension in words ([`Candidate::describe`]).
     pub describe: String,
+    /// Pooled held-out gain of the candidate's reference alone against the
+    /// baseline (see [`ChannelScore::reference_gain`]); 0 without one.
+    pub reference_gain: f64,
+    /// The BIC change against the baseline itself, every fitted parameter
+    /// charged (the reference's keys too): what ranks the qualifying
+    /// candidates ([`super::select`]), all against the same baseline.
+    /// Equal to [`Evaluation::delta_bic`] for a candidate without a
+    /// reference.
+    pub rank_bic: f64,
 }
 
 impl Evaluation {
+    /// The pooled held-out gain against the baseline with the reference's
+    /// part: 1 − (1 − [`Evaluation::oos_gain`])·(1 − [`Evaluation::reference_gain`]).
+    pub fn gain_over_baseline(&self) -> f64 {
+        1.0 - (1.0 - self.oos_gain) * (1.0 - self.reference_gain)
+    }
     /// The largest and the smallest held-out channel gain (NaN, NaN when
     /// no channel has data).
     pub fn channel_range(&self) -> (f64, f64) {
@@ -282,7 +308,10 @@ type Scored = (usize, Result<(Evaluation, Box<dyn Fitted>)>);
 /// it does not act on. A parameter that cannot move a channel's prediction
 /// (PPX1 in Fy) is not part of that channel's model, so it is not charged
 /// there; the pooled BIC, which ranks the qualifying candidates, charges
-/// every parameter.
+/// every parameter. A candidate that fits some of the baseline's own keys
+/// again ([`super::Spec::reference`]) is measured, in every figure above,
+/// against the baseline with those keys alone fitted again on the same
+/// half ([`Candidate::reference`]), and charged only its own parameters.
 pub fn evaluate(
     rec: &Recording,
     baseline: &Tyre,
@@ -307,7 +336,7 @@ pub fn evaluate(
     let n_all = all.iter().filter(|x| **x).count() as f64;
     let n_eff = (n_all * h / DECORRELATION_TIME).max(2.0);
     // Pooled gain of half `m` (0 fit, 1 test, 2 all), and the channel gains.
-    let pooled = |s: &[[(f64, usize); 3]; 3], m: usize| {
+    let pooled = |s: &[[(f64, usize); 3]; 3], sb: &[[(f64, usize); 3]; 3], m: usize| {
         let (mut l, mut n) = (0.0, 0.0);
         for k in 0..3 {
             let ((e, c), (eb, _)) = (s[m][k], sb[m][k]);
@@ -332,48 +361,68 @@ pub fn evaluate(
                 break;
             };
             let _t = crate::fit::timing::span(|| format!("candidate {}", c.name()));
-            let r = c
-                .fit(rec, baseline, opts, &fit_mask, &w)
-                .and_then(|fitted| {
-                    let sim = fitted.predict(rec)?;
-                    let s = score(&sim);
-                    let k = fitted.parameters().len();
-                    let all_gain = pooled(&s, 2);
-                    let channels = (0..3)
-                        .filter(|&j| sb[1][j].1 > 0 && sb[1][j].0 > 0.0)
-                        .map(|j| ChannelScore {
-                            channel: Channel::SCORED[j],
-                            n: sb[1][j].1,
-                            oos_gain: gain(sb[1][j].0, s[1][j].0),
-                            fit_gain: gain(sb[0][j].0, s[0][j].0),
-                            delta_bic: {
-                                let n = (s[2][j].1 as f64 * h / DECORRELATION_TIME).max(2.0);
-                                let kj = match fitted.parameters_on(j) {
-                                    0 => k,
-                                    kj => kj.min(k),
-                                };
-                                n * (s[2][j].0 / sb[2][j].0).max(1e-300).ln() + kj as f64 * n.ln()
+            // The candidate's reference: the baseline, or the baseline
+            // with the keys the candidate fits again beside its own
+            // parameters alone fitted again (`Spec::reference`).
+            let reference = c
+                .reference(baseline, opts)
+                .map(|r| -> Result<_> {
+                    let f = r.fit(rec, baseline, opts, &fit_mask, &w)?;
+                    let on: [usize; 3] = std::array::from_fn(|j| f.parameters_on(j));
+                    Ok((score(&f.predict(rec)?), f.parameters().len(), on))
+                })
+                .transpose();
+            let r = reference.and_then(|reference| {
+                let base = sb;
+                let (sb, k_ref, on_ref) = reference.unwrap_or((sb, 0, [0; 3]));
+                c.fit(rec, baseline, opts, &fit_mask, &w)
+                    .and_then(|fitted| {
+                        let sim = fitted.predict(rec)?;
+                        let s = score(&sim);
+                        let k_all = fitted.parameters().len();
+                        let k = k_all.saturating_sub(k_ref);
+                        let all_gain = pooled(&s, &sb, 2);
+                        let channels = (0..3)
+                            .filter(|&j| sb[1][j].1 > 0 && sb[1][j].0 > 0.0)
+                            .map(|j| ChannelScore {
+                                channel: Channel::SCORED[j],
+                                n: sb[1][j].1,
+                                oos_gain: gain(sb[1][j].0, s[1][j].0),
+                                fit_gain: gain(sb[0][j].0, s[0][j].0),
+                                delta_bic: {
+                                    let n = (s[2][j].1 as f64 * h / DECORRELATION_TIME).max(2.0);
+                                    let kj = match fitted.parameters_on(j) {
+                                        0 => k,
+                                        kj => kj.saturating_sub(on_ref[j]).min(k),
+                                    };
+                                    n * (s[2][j].0 / sb[2][j].0).max(1e-300).ln()
+                                        + kj as f64 * n.ln()
+                                },
+                                baseline_misfit: None,
+                                reference_gain: gain(base[1][j].0, sb[1][j].0),
+                            })
+                            .collect();
+                        Ok((
+                            Evaluation {
+                                name: c.name().into(),
+                                n_params: k,
+                                oos_gain: pooled(&s, &sb, 1),
+                                fit_gain: pooled(&s, &sb, 0),
+                                delta_bic: n_eff * (1.0 - all_gain).max(1e-300).ln()
+                                    + k as f64 * n_eff.ln(),
+                                channels,
+                                parameters: fitted.parameters(),
+                                at_bound: fitted.at_bound(),
+                                physics: c.physics().into(),
+                                describe: c.describe(fitted.as_ref()),
+                                reference_gain: pooled(&sb, &base, 1),
+                                rank_bic: n_eff * (1.0 - pooled(&s, &base, 2)).max(1e-300).ln()
+                                    + k_all as f64 * n_eff.ln(),
                             },
-                            baseline_misfit: None,
-                        })
-                        .collect();
-                    Ok((
-                        Evaluation {
-                            name: c.name().into(),
-                            n_params: k,
-                            oos_gain: pooled(&s, 1),
-                            fit_gain: pooled(&s, 0),
-                            delta_bic: n_eff * (1.0 - all_gain).max(1e-300).ln()
-                                + k as f64 * n_eff.ln(),
-                            channels,
-                            parameters: fitted.parameters(),
-                            at_bound: fitted.at_bound(),
-                            physics: c.physics().into(),
-                            describe: c.describe(fitted.as_ref()),
-                        },
-                        fitted,
-                    ))
-                });
+                            fitted,
+                        ))
+                    })
+            });
             got.push((i, r));
         }
         got

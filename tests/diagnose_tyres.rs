@@ -61,34 +61,38 @@ const TYRES: [(&str, &str); 8] = [
     ),
 ];
 
-/// A recording of `tyre` with `effect` concealed at `level` (its second
-/// formulation where the rig has one when `alt`) at `path`: the rig's
-/// standard programme at one pressure (all three for `pressure`), cornering
-/// at `inclinations`, drive/brake at two slip angles — at 32, 40 and
-/// 48 km/h when `speeds` (a speed programme, as tyre tests and the dev
-/// set's speed recordings run one), else at 40 km/h.
-#[allow(clippy::too_many_arguments)]
-fn record(
-    tyre: &Tyre,
-    effect: &str,
+/// What a probe recording conceals and how the rig runs it.
+struct Case<'a> {
+    /// The rig's effect ("none": a control).
+    effect: &'a str,
+    /// Its level.
     level: f64,
+    /// Its second formulation, where the rig has one.
     alt: bool,
+    /// Inclinations of the cornering blocks (rad), in time order.
     inclinations: Vec<f64>,
+    /// Drive/brake at 32, 40 and 48 km/h (a speed programme, as tyre tests
+    /// and the dev set's speed recordings run one), else at 40 km/h.
     speeds: bool,
-    seed: u64,
-    path: &Path,
-) {
+}
+
+/// A recording of `tyre` with `case` concealed at `path`: the rig's
+/// standard programme at one pressure (all three for `pressure`), cornering
+/// at the case's inclinations, drive/brake at two slip angles.
+fn record(tyre: &Tyre, case: &Case, seed: u64, path: &Path) {
     let mut c = RigConfig::standard(tyre, seed);
     let pr = &mut c.programme;
-    if effect != "pressure" {
+    if case.effect != "pressure" {
         pr.pressures = vec![pr.pressures[1]];
     }
-    pr.inclinations = inclinations;
+    pr.inclinations = case.inclinations.clone();
     pr.db_alphas.truncate(2);
-    if speeds {
+    if case.speeds {
         pr.db_speeds = [32.0, 40.0, 48.0].iter().map(|v| v / 3.6).collect();
     }
-    let mut truth = alt
+    let (effect, level) = (case.effect, case.level);
+    let mut truth = case
+        .alt
         .then(|| effects::concealed_alt(effect, tyre.clone(), level))
         .flatten()
         .or_else(|| effects::concealed(effect, tyre.clone(), level))
@@ -101,16 +105,14 @@ fn record(
 /// A control recording of `tyre`: [`record`] without an effect, cornering
 /// at 0 and 2°.
 fn control(tyre: &Tyre, seed: u64, path: &Path) {
-    record(
-        tyre,
-        "none",
-        1.0,
-        false,
-        vec![0.0, 2f64.to_radians()],
-        false,
-        seed,
-        path,
-    );
+    let case = Case {
+        effect: "none",
+        level: 1.0,
+        alt: false,
+        inclinations: vec![0.0, 2f64.to_radians()],
+        speeds: false,
+    };
+    record(tyre, &case, seed, path);
 }
 
 /// `tyrekit diagnose REC --report DIR` as a user runs it (no `--tir`) on
@@ -329,16 +331,14 @@ fn effects_on_other_tyres_get_no_wrong_name() {
             let tag = format!("t{k}_{effect}{}", if speeds { "_speeds" } else { "" });
             let rec = dir.join(format!("{tag}.mat"));
             let seed = 300 + 10 * k as u64 + e as u64;
-            record(
-                &tyre,
+            let case = Case {
                 effect,
-                2.0,
-                true,
-                inclinations.clone(),
+                level: 2.0,
+                alt: true,
+                inclinations: inclinations.clone(),
                 speeds,
-                seed,
-                &rec,
-            );
+            };
+            record(&tyre, &case, seed, &rec);
             let (_, d) = diagnose(file, &rec, &dir.join(&tag));
             let verdict = d["verdict"].as_str().unwrap_or("?").to_string();
             let programme = if speeds { "3 speeds" } else { "1 speed" };

@@ -75,23 +75,25 @@ fn cooling(t: &Tyre) -> f64 {
     COOLING_PER_N * fz0
 }
 
-/// A scale factor of the file (LXAL, LYKA) as a parameter, ½–2× its
-/// value (1 where the file has none).
-fn weight(t: &Tyre, key: &'static str) -> Param {
-    let v = match file(t, key) {
+/// The file's value of a scale factor (LMUX, LXAL, LYKA); 1 where it has
+/// none or one that is not a positive number.
+fn scale(t: &Tyre, key: &str) -> f64 {
+    match file(t, key) {
         v if v.is_finite() && v > 0.0 => v,
         _ => 1.0,
-    };
+    }
+}
+
+/// A scale factor of the file (LXAL, LYKA) as a parameter, ½–2× its value.
+fn weight(t: &Tyre, key: &'static str) -> Param {
+    let v = scale(t, key);
     p(key, vec![Target::Key(key)], v, 0.5 * v, 2.0 * v, 0.01 * v)
 }
 
 fn thermal_spec(t: &Tyre, _: &ReplayOptions) -> Option<Spec> {
     let th = |k| Target::Section(THERMAL_SECTION, k);
     let h = cooling(t);
-    let lmux = match file(t, "LMUX") {
-        v if v.is_finite() && v > 0.0 => v,
-        _ => 1.0,
-    };
+    let lmux = scale(t, "LMUX");
     Some(Spec {
         params: vec![
             p(

@@ -265,7 +265,8 @@ const PROBE_EFFECTS: [(&str, bool); 8] = [
 /// One effect cannot be told from the baseline here, so `none` is the right
 /// answer for it, not a miss: the rig's rolling-radius error
 /// (κ' = (1 + κ)(1 + a·dfz) − 1) is a load-proportional slip shift, which
-/// PHX2 holds. (Speed friction at one belt speed, until 4 Dec 2026: named
+/// PHX2 holds in Fx (in Fy's combined-slip terms it does not: some tyres'
+/// recordings end in "baseline misfit", README). (Speed friction at one belt speed, until 4 Dec 2026: named
 /// on 0 of 4; in the speed programme on 4 of 4.) Cornering is upright because inclination blocks run in time
 /// order (0° then 2°, as in many TTC runs) let the baseline's camber terms
 /// take up a tread temperature rising through the run, and the thermal

@@ -286,6 +286,12 @@ const PROBE_EFFECTS: [(&str, bool); 8] = [
 /// the overshadow rule's second case (the PAC2002) and by the thermal
 /// candidate's combined-slip weights scored against their reference (the
 /// other two; no wrong name in 32, thermal named on 4 of 4).
+/// `TYREKIT_PROBE_TYRES=a.tir,b.tir` probes those files of
+/// `../shared/data/tir` instead of [`EFFECT_TYRES`]: with MF 5.2's example,
+/// the TTC-fitted MF 6.1 Hoosier R25B, a PAC2002 SUV and a PAC2002 van tyre
+/// (4 Dec 2026) one wrong name in 32 — the Hoosier's speed-programme
+/// control, `rolling_radius` on Mz alone, since then `thermal` (README,
+/// "More tyres"); named 16 of 24.
 /// `TYREKIT_PROBE_CAMBER=0,2` corners at those inclinations (degrees, in
 /// that order) instead of upright: the known limit above, measured 4 Dec
 /// 2026 (stop 69): no wrong name in 32, thermal named on 0 of 4, load
@@ -322,7 +328,18 @@ fn effects_on_other_tyres_get_no_wrong_name() {
         .unwrap_or_else(|| vec![0.0]);
     let mut wrong = Vec::new();
     let (mut named, mut concealed) = (0, 0);
-    for (k, (file, why)) in EFFECT_TYRES.iter().enumerate() {
+    let tyres: Vec<(String, &str)> = match std::env::var("TYREKIT_PROBE_TYRES") {
+        Ok(v) if !v.trim().is_empty() => v
+            .split(',')
+            .map(|f| (f.trim().to_string(), "chosen by TYREKIT_PROBE_TYRES"))
+            .collect(),
+        _ => EFFECT_TYRES
+            .iter()
+            .map(|&(f, why)| (f.to_string(), why))
+            .collect(),
+    };
+    for (k, (file, why)) in tyres.iter().enumerate() {
+        let file = file.as_str();
         let tyre = Tyre::from_file(&tir.join(file)).expect("a shared tyre file");
         for (e, &(effect, speeds)) in PROBE_EFFECTS.iter().enumerate() {
             if !filter.is_empty() && !effect.contains(filter.as_str()) {

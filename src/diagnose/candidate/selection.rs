@@ -7,7 +7,9 @@
 //! exceeds [`MIN_GAIN`], whose own BIC falls and whose baseline misfit, if
 //! any, it explains in good part ([`ChannelScore::baseline_misfit`]), or one
 //! whose gain another candidate dwarfs in the same channel, or in a channel
-//! where only the other shows an effect ([`OVERSHADOW`]).
+//! where only the other shows an effect ([`OVERSHADOW`]), or one whose
+//! evidence lies only in channels its parameters do not act on
+//! ([`ChannelScore::acts`]).
 
 use super::{ChannelScore, Evaluation, Fitted};
 use crate::residual::Channel;
@@ -49,8 +51,16 @@ pub const OVERSHADOW: f64 = 2.0;
 /// removes part of the baseline's own error, and a small gain says nothing
 /// about the physics: a drive/brake-only run, whose combined-slip Fy the
 /// baseline fits at 9–17× the noise floor, had its Fy gains read as LuGre.
+///
+/// And the candidate's parameters act on the channel
+/// ([`ChannelScore::acts`]): a rolling radius, whose keys act on Fx, that
+/// leaves Fx unchanged yet removes 8 % of Mz through the combined-slip
+/// terms was named on a control (rig recording of the TTC-fitted MF 6.1
+/// Hoosier R25B in a speed programme, 4 Dec 2026: Fx +0.0 %, Fy −3.3 %,
+/// Mz +7.8 %, Mz BIC −2.0) — physics that changes the slip shows in the
+/// force the slip drives first.
 fn shows(c: &ChannelScore) -> bool {
-    gains(c) && c.baseline_misfit.is_none()
+    gains(c) && c.baseline_misfit.is_none() && c.acts
 }
 
 /// Whether channel `c`'s held-out error falls by more than [`MIN_GAIN`] and
@@ -266,6 +276,28 @@ pub fn why_not(e: &Evaluation) -> Option<String> {
         )
     } else if !(e.oos_gain > 0.0 && e.fit_gain > 0.0) {
         "the channels together do not gain both in and out of sample".into()
+    } else if e
+        .channels
+        .iter()
+        .any(|c| gains(c) && c.baseline_misfit.is_none() && !c.acts)
+    {
+        let off: Vec<String> = e
+            .channels
+            .iter()
+            .filter(|c| gains(c) && !c.acts)
+            .map(|c| format!("{} {:.1} %", c.channel.name(), 100.0 * c.oos_gain))
+            .collect();
+        let own: Vec<String> = e
+            .channels
+            .iter()
+            .filter(|c| c.acts)
+            .map(|c| format!("{} {:+.1} %", c.channel.name(), 100.0 * c.oos_gain))
+            .collect();
+        format!(
+            "its gain lies only in a channel its parameters do not act on ({}), while the channel they act on shows nothing ({}): a side effect of the fit, not this physics",
+            off.join(", "),
+            own.join(", ")
+        )
     } else if e.channels.iter().any(gains) {
         let misfit: Vec<String> = e
             .channels
@@ -323,6 +355,7 @@ mod tests {
                     delta_bic: b,
                     baseline_misfit: None,
                     reference_gain: 0.0,
+                    acts: true,
                 })
                 .collect(),
             parameters: vec![],
@@ -389,6 +422,33 @@ mod tests {
             ..e.channels[0].clone()
         };
         assert!(qualifies(&e), "evidence in the well-fitted Fx");
+    }
+
+    /// The control that named a rolling radius on Mz alone (rig, TTC-fitted
+    /// MF 6.1 Hoosier, speed programme; see [`shows`]): its keys act on Fx,
+    /// which gains nothing, so the Mz gain names nothing and the words say
+    /// why; the same gains with the parameters acting on Mz qualify.
+    #[test]
+    fn a_gain_only_where_the_parameters_do_not_act_names_nothing() {
+        let mut e = ev(
+            &[
+                (Channel::Fx, 0.0, 12.9),
+                (Channel::Fy, -0.033, 22.0),
+                (Channel::Mz, 0.078, -2.0),
+            ],
+            0.01,
+            9.5,
+        );
+        assert!(qualifies(&e), "with the parameters acting on Mz");
+        for c in &mut e.channels {
+            c.acts = c.channel == Channel::Fx;
+        }
+        assert!(!qualifies(&e));
+        let why = why_not(&e).unwrap();
+        assert!(
+            why.contains("do not act on (Mz 7.8 %)") && why.contains("Fx +0.0 %"),
+            "{why}"
+        );
     }
 
     /// An effect that lives in one channel (a friction law of the sliding

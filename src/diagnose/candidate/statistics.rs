@@ -48,6 +48,12 @@ pub struct ChannelScore {
     /// the keys of [`super::Spec::reference`] fitted again) against the
     /// baseline; 0 for a candidate scored against the baseline itself.
     pub reference_gain: f64,
+    /// Whether any of the candidate's fitted parameters acts on this
+    /// channel ([`Fitted::parameters_on`], the channels a parameter is
+    /// declared on with `Param::on`): where the physics shows first. A
+    /// gain in a channel the parameters do not act on is a side effect of
+    /// the fit and cannot carry the verdict (see `selection`).
+    pub acts: bool,
 }
 
 impl ChannelScore {
@@ -400,6 +406,7 @@ pub fn evaluate(
                                 },
                                 baseline_misfit: None,
                                 reference_gain: gain(base[1][j].0, sb[1][j].0),
+                                acts: fitted.parameters_on(j) > 0,
                             })
                             .collect();
                         Ok((

@@ -658,7 +658,9 @@ pub(crate) fn run_stage(
     let mut extra = Vec::new();
     if multi_start && !matches!(kind, StageKind::Mx | StageKind::My) {
         extra.push(neutral_start(kind, &params));
-        extra.extend(super::initial::estimate(kind, &tyre.p, &data, &params));
+        if let Some(s) = super::initial::estimate(kind, &tyre.p, &data, &params) {
+            extra.push(s);
+        }
     }
     let out = fit_stage(
         ctx.form,

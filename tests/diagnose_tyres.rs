@@ -290,8 +290,9 @@ const PROBE_EFFECTS: [(&str, bool); 8] = [
 /// `../shared/data/tir` instead of [`EFFECT_TYRES`]: with MF 5.2's example,
 /// the TTC-fitted MF 6.1 Hoosier R25B, a PAC2002 SUV and a PAC2002 van tyre
 /// (4 Dec 2026) one wrong name in 32 — the Hoosier's speed-programme
-/// control, `rolling_radius` on Mz alone, since then `thermal` (README,
-/// "More tyres"); named 16 of 24.
+/// control, `rolling_radius` on Mz alone, then `thermal`, both from a
+/// baseline held to |PEX4| ≤ 0.99 where the file has −1.17 (README, "More
+/// tyres"); since PEX4's box holds it, no wrong name in 32, named 17 of 24.
 /// `TYREKIT_PROBE_CAMBER=0,2` corners at those inclinations (degrees, in
 /// that order) instead of upright: the known limit above, measured 4 Dec
 /// 2026 (stop 69): no wrong name in 32, thermal named on 0 of 4, load

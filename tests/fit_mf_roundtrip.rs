@@ -9,7 +9,7 @@
 use crate::common;
 
 use tyrekit::data::Recording;
-use tyrekit::fit::mf_fit::{fit_mf, MfFitOptions};
+use tyrekit::fit::mf_fit::{fit_mf, MfFit, MfFitOptions};
 use tyrekit::fit::mf_stages::{StageKind, FIT_MODE};
 use tyrekit::mf::{MfInput, Tyre};
 use tyrekit::rig::{simulate, RigConfig, SteadyMf};
@@ -40,27 +40,40 @@ fn start_with_nominals(truth: &TyreParams) -> TyreParams {
     s
 }
 
-fn round_trip(file: &str, seed: u64) {
-    let dir = common::shared().join("data/tir");
-    let path = dir.join(file);
+/// The shared file `file` as truth, its standard programme recorded with
+/// `seed` and fitted (stages `only`) from the built-in tyre; None (with a
+/// SKIP message) without `../shared`.
+fn fit_shared(
+    file: &str,
+    seed: u64,
+    only: Vec<StageKind>,
+) -> Option<(TyreParams, Tyre, [Recording; 1], MfFit)> {
+    let path = common::shared().join("data/tir").join(file);
     if !path.exists() {
         eprintln!(
             "SKIP: {} absent (shared data not available)",
             path.display()
         );
-        return;
+        return None;
     }
     let truth_p = TyreParams::from_file(&path).unwrap();
     let truth = Tyre::new(truth_p.clone()).unwrap();
     let tmp = common::scratch(&format!("fit-mf-rt-{seed}"));
-    let rec = recording(&truth, seed, tmp.path());
+    let recs = [recording(&truth, seed, tmp.path())];
     let opts = MfFitOptions {
-        only: vec![StageKind::PureFx, StageKind::PureFy],
+        only,
         nominal_from_data: false,
         ..Default::default()
     };
-    let recs = [rec];
     let res = fit_mf(&recs, start_with_nominals(&truth_p), &opts, None).unwrap();
+    Some((truth_p, truth, recs, res))
+}
+
+fn round_trip(file: &str, seed: u64) {
+    let only = vec![StageKind::PureFx, StageKind::PureFy];
+    let Some((truth_p, truth, recs, res)) = fit_shared(file, seed, only) else {
+        return;
+    };
     println!("{file}:\n{}", res.report.to_text());
     let fitted = Tyre::new(res.tyre.clone()).unwrap();
     let rec = &recs[0];
@@ -216,4 +229,64 @@ fn round_trip_reference_tvd3() {
 #[test]
 fn round_trip_pacejka_book() {
     round_trip("PacejkaBook_Defaults.tir", 12);
+}
+
+/// A TTC-fitted FSAE tyre (MF 6.1) whose Fx curvature has opposite signs
+/// driving and braking (PEX1 0.46, PEX4 −1.17: Ex +0.99 driving, −0.08
+/// braking). PEX4 confined to ±0.99 cannot give it, and from a start with
+/// the mean curvature negative LM cannot reach it (between the two
+/// branches lies PEX1 = 0, where PEX4 is not identified): the fit ended at
+/// PEX4 = +3 (its bound) with σ_Fx 1.43 % against the truth's 0.87 % and
+/// its Fx curve 3.9 % of the peak off (4 Dec 2026; the diagnosis's
+/// control recordings of this tyre then missed the drive-side Fx by 3 %).
+/// The flat-top start of `fit::initial` reaches it. Fx only: this file's
+/// Fy camber and pressure terms (PEY5 −118, PPY5 −131) are not identified
+/// by the rig's one-sided inclinations (0°, 2°, 4°) and its Fy curve is
+/// 2 % of the peak off either way.
+#[test]
+fn round_trip_ttc_hoosier_r25b_fx() {
+    let file = "Hoosier-20.5x7x13R25B-ISO.TIR";
+    let Some((truth_p, truth, recs, res)) = fit_shared(file, 14, vec![StageKind::PureFx]) else {
+        return;
+    };
+    let fitted = Tyre::new(res.tyre.clone()).unwrap();
+    let (pex1, pex4) = (res.tyre.get("pex1").unwrap(), res.tyre.get("pex4").unwrap());
+    println!("PEX1 {pex1} (truth 0.458), PEX4 {pex4} (truth −1.173)");
+    // The branch: drive-side Ex above 0.5, brake-side below 0.2.
+    let ex = |s: f64| pex1 * (1.0 - pex4 * s);
+    assert!(
+        ex(1.0) > 0.5 && ex(-1.0) < 0.2,
+        "Ex {:.3} driving, {:.3} braking: not the file's branch",
+        ex(1.0),
+        ex(-1.0)
+    );
+    // Fx within 1 % of the peak over the data's loads and κ ±0.2, upright,
+    // nominal pressure, against the truth as the rig recorded it (its
+    // constant Fx offset added; κ needs no offset).
+    let nz = rig(&truth, 14).noise;
+    let (fz0, fz1) = recs[0]
+        .segments
+        .iter()
+        .fold((f64::MAX, f64::MIN), |a, g| (a.0.min(g.fz), a.1.max(g.fz)));
+    let mut worst = 0.0f64;
+    for i in 0..=6 {
+        let base = MfInput {
+            fz: fz0 + (fz1 - fz0) * i as f64 / 6.0,
+            vx: truth_p.p.longvl.max(5.0),
+            p: truth_p.p.nompres,
+            ..Default::default()
+        };
+        let at = |t: &Tyre, k: f64| t.forces(&MfInput { kappa: k, ..base }, FIT_MODE).fx;
+        let ks: Vec<f64> = (0..=40).map(|j| -0.2 + 0.4 * j as f64 / 40.0).collect();
+        let peak = ks.iter().map(|&k| at(&truth, k).abs()).fold(0.0, f64::max);
+        for &k in &ks {
+            worst = worst.max((at(&fitted, k) - at(&truth, k) - nz.fx_offset).abs() / peak);
+        }
+    }
+    println!("worst |fitted − truth| / peak: Fx {:.3} %", 100.0 * worst);
+    assert!(
+        worst < 0.01,
+        "Fx curve off by {:.3} % of peak",
+        100.0 * worst
+    );
 }

@@ -49,17 +49,74 @@ struct Bin {
     c: Option<f64>,
     /// |slip| of the peak.
     xm: f64,
+    /// |slip| of the peak on the positive and on the negative side of the
+    /// slip (None where a side has no samples near its peak).
+    xm_side: [Option<f64>; 2],
 }
 
 /// Estimates for a pure Fx or Fy stage over `params` (θ over the stage's
-/// table, the current values where nothing is estimated); `None` for other
-/// stages or when fewer than one usable load bin is found.
+/// table, the current values where nothing is estimated): the estimate,
+/// then — for a curve whose two sides' curvatures differ by more than
+/// [`SIDE_SPREAD`] — the same with its flatter side's E at the estimate's
+/// largest (see [`flat_top`]). Empty for other stages or when no usable
+/// load bin is found.
 pub fn estimate(
     kind: StageKind,
     p: &MfParams<f64>,
     data: &StageData,
     params: &[Param],
-) -> Option<Vec<f64>> {
+) -> Vec<Vec<f64>> {
+    estimate_sets(kind, p, data)
+        .unwrap_or_default()
+        .into_iter()
+        .filter(|set| set.iter().all(|(_, v)| v.is_finite()))
+        .map(|set| {
+            params
+                .iter()
+                .map(
+                    |q| match set.iter().find(|(k, _)| q.name.eq_ignore_ascii_case(k)) {
+                        Some((_, v)) if q.free => q.clamp(*v),
+                        _ => q.start,
+                    },
+                )
+                .collect()
+        })
+        .collect()
+}
+
+/// Difference between the two sides' estimated curvatures E₊, E₋ above
+/// which [`estimate`] adds the flat-top start (0.2: well above the
+/// scatter of E read from the peak slip of a symmetric curve's two sides).
+pub const SIDE_SPREAD: f64 = 0.2;
+
+/// The largest curvature an estimate gives (E read from the peak slip is
+/// clamped to it; 1 is the validity bound).
+const E_MAX: f64 = 0.9;
+
+/// The flat-top variant of an estimate's curvature: both sides' E moved
+/// by the same amount until the flatter side reaches [`E_MAX`], returned
+/// as (E0 shift, sign term). E read from the peak slip (4.9) depends on
+/// the C and B estimated with it, so its level is uncertain while the
+/// difference between the sides is what the sweep shows directly — and the
+/// level decides the branch: E = E0·(1 − a·sgn x) with the sides of
+/// opposite signs (|a| > 1) is reached by LM only from a start with E0 of
+/// the right sign, since between the branches lies E0 = 0, where a is not
+/// identified. A side whose force still rises at the end of the sweep (a
+/// TTC-fitted FSAE tyre's driving side: E = +0.99 against −0.08 braking)
+/// reads as the flatter side with too low an E.
+fn flat_top(e_pos: f64, e_neg: f64) -> Option<(f64, f64)> {
+    let shift = E_MAX - e_pos.max(e_neg);
+    let (p, n) = (e_pos + shift, e_neg + shift);
+    ((e_pos - e_neg).abs() > SIDE_SPREAD && shift > 0.05 && (p + n).abs() > 1e-3)
+        .then(|| (shift, (n - p) / (n + p)))
+}
+
+/// The (key, value) sets behind [`estimate`].
+fn estimate_sets(
+    kind: StageKind,
+    p: &MfParams<f64>,
+    data: &StageData,
+) -> Option<Vec<Vec<(&'static str, f64)>>> {
     let lateral = match kind {
         StageKind::PureFy => true,
         StageKind::PureFx => false,
@@ -106,11 +163,11 @@ pub fn estimate(
     }
     let fz0 = p.get("fnomin")? * p.get("lfzo").unwrap_or(1.0);
     let dfz = |fz: f64| (fz - fz0) / fz0;
-    let mut set: Vec<(&str, f64)> = Vec::new();
-    let (c_key, d1, d2, e1, e2) = if lateral {
-        ("pcy1", "pdy1", "pdy2", "pey1", "pey2")
+    let mut set: Vec<(&'static str, f64)> = Vec::new();
+    let (c_key, d1, d2, e1, e2, e_sign) = if lateral {
+        ("pcy1", "pdy1", "pdy2", "pey1", "pey2", "pey3")
     } else {
-        ("pcx1", "pdx1", "pdx2", "pex1", "pex2")
+        ("pcx1", "pdx1", "pdx2", "pex1", "pex2", "pex4")
     };
     // C: the mean over bins whose sweep reached the asymptote; else current.
     let cs: Vec<f64> = bins.iter().filter_map(|b| b.c).collect();
@@ -127,20 +184,29 @@ pub fn estimate(
     if bins.len() > 1 {
         set.push((d2, m1));
     }
-    // E from the peak slip per bin (B = K/(CD)), linear in dfz.
-    let es: Vec<(f64, f64)> = bins
-        .iter()
-        .map(|b| {
-            let bx = (b.k / (c * b.d)).abs() * b.xm;
-            let e = (bx - (PI / (2.0 * c)).tan()) / (bx - bx.atan());
-            (dfz(b.fz), e.clamp(-5.0, 0.9))
-        })
-        .collect();
+    // E from the peak slip per bin (B = K/(CD)), linear in dfz, from the
+    // peak slip pooled over both sides; where the sweep reached both
+    // sides' peaks, E on each side too (for the flat-top start below).
+    let e_at = |b: &Bin, xm: f64| {
+        let bx = (b.k / (c * b.d)).abs() * xm;
+        ((bx - (PI / (2.0 * c)).tan()) / (bx - bx.atan())).clamp(-5.0, 0.9)
+    };
+    let side_es = |b: &Bin| match b.xm_side {
+        [Some(p), Some(n)] => Some((e_at(b, p), e_at(b, n))),
+        _ => None,
+    };
+    let sides: Vec<(f64, f64)> = bins.iter().filter_map(side_es).collect();
+    let es: Vec<(f64, f64)> = bins.iter().map(|b| (dfz(b.fz), e_at(b, b.xm))).collect();
     let (ea, eb) = line(&es);
     set.push((e1, ea));
     if bins.len() > 1 {
         set.push((e2, eb));
     }
+    let n_sides = sides.len().max(1) as f64;
+    let (ep, en) = sides.iter().fold((0.0, 0.0), |(a, b), (p, n)| {
+        (a + p / n_sides, b + n / n_sides)
+    });
+    let flat = (!sides.is_empty()).then(|| flat_top(ep, en)).flatten();
     if lateral {
         // Kya = PKY1·Fz0·sin(PKY4·atan(Fz/(PKY2·Fz0))) (4.E25, upright):
         // PKY4 kept, PKY2 on a grid, PKY1 by least squares for each.
@@ -174,20 +240,23 @@ pub fn estimate(
             set.push(("pkx3", 0.0));
         }
     }
-    if set.iter().any(|(_, v)| !v.is_finite()) {
-        return None;
+    // The flat-top start: the sign term (PEX4 in 4.E14, PEY3 in 4.E24),
+    // E = E0·(1 − a·sgn x), from the two sides' shifted curvatures, and
+    // E0 their mean. A tyre whose curvature has opposite signs driving and
+    // braking (|a| > 1) is reached only from a start on its side: from
+    // a = 0 the fit would have to take E0 through zero, where a is not
+    // identified. The main estimate keeps the pooled E and the current
+    // sign term: the per-side E is the less certain reading (fewer
+    // samples near each side's peak), and a start built on it alone
+    // misled the fit of symmetric curves.
+    let mut sets = vec![set.clone()];
+    if let Some((shift, a)) = flat {
+        set.retain(|(k, _)| *k != e_sign && *k != e1);
+        set.push((e_sign, a));
+        set.push((e1, 0.5 * (ep + en) + shift));
+        sets.push(set);
     }
-    Some(
-        params
-            .iter()
-            .map(
-                |q| match set.iter().find(|(k, _)| q.name.eq_ignore_ascii_case(k)) {
-                    Some((_, v)) if q.free => q.clamp(*v),
-                    _ => q.start,
-                },
-            )
-            .collect(),
-    )
+    Some(sets)
 }
 
 /// `idx` (sorted by load) without the samples of sparse load cells — the
@@ -269,6 +338,18 @@ fn bin(
         .collect();
     near.sort_by(|a, b| a.total_cmp(b));
     let xm = *near.get(near.len() / 2)?;
+    let side = |positive: bool| {
+        let on_side = |i: &&usize| (slip(**i) > 0.0) == positive;
+        let mut v: Vec<f64> = ix
+            .iter()
+            .filter(|&&i| y[i] >= 0.97 * yhi || y[i] <= 0.97 * ylo)
+            .filter(on_side)
+            .map(|&i| slip(i).abs())
+            .collect();
+        v.sort_by(|a, b| a.total_cmp(b));
+        v.get(v.len() / 2).copied()
+    };
+    let xm_side = [side(true), side(false)];
     // Asymptote: mean |F| over the largest 5 % of |slip|; C only where the
     // force there has fallen clearly below the peak (else the sweep ended
     // near the peak and C is not seen).
@@ -286,6 +367,7 @@ fn bin(
         k,
         c,
         xm,
+        xm_side,
     })
 }
 
@@ -357,7 +439,10 @@ mod tests {
                 start.set(k, start.get(k).unwrap() * f);
             }
             let params = stage_params(kind, &start, true, true);
-            let theta = estimate(kind, &start, &data, &params).expect("an estimate");
+            let theta = estimate(kind, &start, &data, &params)
+                .into_iter()
+                .next()
+                .expect("an estimate");
             let rms = |p: &MfParams<f64>| {
                 let d2 = sweeps(p, lateral);
                 let peak = data.meas[0].iter().fold(0.0f64, |a, v| a.max(v.abs()));
@@ -385,6 +470,48 @@ mod tests {
                 "{kind:?}: estimate RMS {r_est:.3} of the peak"
             );
         }
+    }
+
+    /// A curve flatter on one side: Fx with Ex +0.99 driving and −0.08
+    /// braking (a TTC-fitted FSAE tyre's PEX1 0.46, PEX4 −1.17 on the
+    /// built-in tyre). The estimate reads the driving side as the flatter
+    /// one (E₊ > E₋) and adds a second start whose mean curvature is
+    /// positive — the file's branch — with E₊ > E₋ kept; a curve with equal
+    /// sides (PEX4 = 0) gets one start only.
+    #[test]
+    fn a_curve_flatter_on_one_side_gets_a_flat_top_start() {
+        let mut truth = TyreParams::builtin().p;
+        for (k, v) in [
+            ("pex1", 0.458),
+            ("pex2", 0.0),
+            ("pex3", 0.0),
+            ("pex4", -1.1726),
+        ] {
+            truth.set(k, v);
+        }
+        let data = sweeps(&truth, false);
+        let start = TyreParams::builtin().p;
+        let params = stage_params(StageKind::PureFx, &start, true, true);
+        let at = |theta: &[f64], k: &str| {
+            theta[params
+                .iter()
+                .position(|q| q.name.eq_ignore_ascii_case(k))
+                .unwrap()]
+        };
+        let starts = estimate(StageKind::PureFx, &start, &data, &params);
+        assert_eq!(starts.len(), 2, "a flat-top start for a one-sided flat top");
+        let (e0, a) = (at(&starts[1], "pex1"), at(&starts[1], "pex4"));
+        let (e_drive, e_brake) = (e0 * (1.0 - a), e0 * (1.0 + a));
+        eprintln!("flat-top start: PEX1 {e0:.3}, PEX4 {a:.3}: Ex {e_drive:.3} / {e_brake:.3}");
+        assert!(e0 > 0.0, "mean curvature {e0} not on the file's branch");
+        assert!(
+            e_drive > e_brake,
+            "the flatter side lost: {e_drive} / {e_brake}"
+        );
+        assert!(e_drive <= E_MAX + 1e-9);
+        truth.set("pex4", 0.0);
+        let data = sweeps(&truth, false);
+        assert_eq!(estimate(StageKind::PureFx, &start, &data, &params).len(), 1);
     }
 
     /// Load ramps between the set points (as a rig drives them, at zero
@@ -424,8 +551,8 @@ mod tests {
                 start.set(k, 0.0);
             }
             let params = stage_params(kind, &start, true, true);
-            let a = estimate(kind, &start, &clean, &params).expect("an estimate");
-            let b = estimate(kind, &start, &ramped, &params).expect("an estimate");
+            let a = estimate(kind, &start, &clean, &params).swap_remove(0);
+            let b = estimate(kind, &start, &ramped, &params).swap_remove(0);
             for ((q, x), y) in params.iter().zip(&a).zip(&b) {
                 assert!(
                     (x - y).abs() <= 0.01 * x.abs().max(0.1),

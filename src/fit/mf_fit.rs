@@ -658,9 +658,7 @@ pub(crate) fn run_stage(
     let mut extra = Vec::new();
     if multi_start && !matches!(kind, StageKind::Mx | StageKind::My) {
         extra.push(neutral_start(kind, &params));
-        if let Some(s) = super::initial::estimate(kind, &tyre.p, &data, &params) {
-            extra.push(s);
-        }
+        extra.extend(super::initial::estimate(kind, &tyre.p, &data, &params));
     }
     let out = fit_stage(
         ctx.form,

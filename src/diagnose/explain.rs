@@ -218,7 +218,7 @@ pub fn explain(
                     100.0 * alpha
                 ),
                 Some(w) if small => format!(
-                    "{nothing}: the structure the residual shows is real but small — {w} — each part under the {:.0} % of its channel's squares that a candidate must remove to be named, and {best}.",
+                    "{nothing}: the structure the residual shows is real but small — {w} — each part under the {:.1} % of its channel's squares that a candidate must remove to be named, and {best}.",
                     100.0 * MIN_GAIN
                 ),
                 Some(w) => format!(

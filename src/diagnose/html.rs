@@ -140,7 +140,7 @@ figcaption{{font-size:.9em;color:#444}} details{{margin:1em 0}}\
     // Locate.
     let _ = writeln!(
         s,
-        "<h2>Where the residual concentrates (baseline)</h2>\n<p><small>Each grouping: a statistic, its permutation p-value (segment-level groupings permute segments; sample-level ones shift each segment's residual circularly, keeping its autocorrelation), Holm-adjusted over the groupings of the channel; significant rows highlighted (family-wise 5 %). Size: the share of the channel's squared residual the grouping accounts for — significance says the structure is not noise, the size whether it matters (a named effect must remove {:.0} %).</small></p>",
+        "<h2>Where the residual concentrates (baseline)</h2>\n<p><small>Each grouping: a statistic, its permutation p-value (segment-level groupings permute segments; sample-level ones shift each segment's residual circularly, keeping its autocorrelation), Holm-adjusted over the groupings of the channel; significant rows highlighted (family-wise 5 %). Size: the share of the channel's squared residual the grouping accounts for — significance says the structure is not noise, the size whether it matters (a named effect must remove {:.1} %).</small></p>",
         100.0 * super::candidate::MIN_GAIN
     );
     for (ch, f) in &d.findings {

@@ -67,8 +67,7 @@
 //!   acting on the channel, [`Fitted::parameters_on`]).
 //! * Verdict ([`select`], [`qualifies`]): a candidate qualifies when some
 //!   channel's held-out error falls by more than [`MIN_GAIN`] and that
-//!   channel's own BIC falls by [`MIN_EVIDENCE`] (an effect may live in one
-//!   channel), none rises
+//!   channel's own BIC falls (an effect may live in one channel), none rises
 //!   by more than [`MAX_LOSS`] (physics that is missing makes no channel
 //!   worse; a candidate that trades one channel for another absorbs a
 //!   misfit), and the pooled held-out and in-sample gains are positive;
@@ -111,7 +110,7 @@ pub use crate::residual::{FX, FY, MZ};
 pub use param::{NoneCandidate, Param, ParamCandidate, ReferenceOf, Spec, Target, STATIC_SAMPLES};
 pub use selection::{
     also_qualifying, channels_in_words, overshadowed, overshadowed_in_words, overshadowed_summary,
-    qualifies, select, why_not, MAX_LOSS, MIN_EVIDENCE, MIN_GAIN, OVERSHADOW,
+    qualifies, select, why_not, MAX_LOSS, MIN_GAIN, OVERSHADOW,
 };
 pub use statistics::{
     evaluate, every_segment, fit_weights, held_out_sse, refit_on_all, smoothed_inputs, split,

@@ -420,6 +420,128 @@ fn devset_diagnosis_meets_the_issue_figures() {
     assert!(m >= GAP_MEDIAN_MIN, "median gap {m:.2} < {GAP_MEDIAN_MIN}");
 }
 
+/// Right names on the recordings cut at the answer's split (measured
+/// 4 Dec 2026: 10 of 18; the whole recordings' guard is [`NAMED_BEFORE`]).
+const FIT_ROWS_NAMED_BEFORE: usize = 10;
+/// Most that the median over the 21 of baseline.tir / the answer's baseline
+/// on the gap rows may stand from 1 when both are fitted on the same rows:
+/// the figures below compare like with like only if it holds (measured
+/// 4 Dec 2026: median 1.00, r02's rolling-radius Mz 0.73 the lowest).
+const FIT_ROWS_BASELINE_MATCH: f64 = 0.05;
+
+/// Where the acceptance's median gap stands when `baseline.tir` is fitted as
+/// the answer's baseline was — on the rows before the answer's split, so
+/// that neither file sees the rows it is judged on. The diagnosis of the
+/// whole recording fits its baseline on every row, the last 30 % too: a
+/// time-dependent or condition-level effect there is partly taken up by the
+/// baseline itself (r14 thermal: 44 % of the answer's gap, r02 rolling
+/// radius 94 %), and what is left for the extension to recover is that much
+/// smaller ([`reach`]). Here every recording is cut at `eval_split_ET_s`,
+/// diagnosed as a user would, and both files are replayed over the whole
+/// recording: baseline.tir then lands on the answer's baseline
+/// ([`FIT_ROWS_BASELINE_MATCH`]) and the gap recovered measures the
+/// extension alone, out of sample in time.
+///
+/// Measured 4 Dec 2026 (the code of 3cbb5b3): right names 10 of 18 (less
+/// data: speed friction and thermal fall under their evidence), median gap
+/// over them 65 % (r16 thermal 62 % against 26 % from the whole recording,
+/// r04 pressure 33 % against 2 %), controls 3/3 `none`; one wrong name,
+/// r09 (pressure) → thermal on a 3.3 % Mz gain with a Mz BIC of −0.6 (the
+/// whole recording names pressure), which is why no wrong name is not
+/// asserted here (see the README).
+#[test]
+#[ignore = "on demand (≈ 6 min): the gap with both files fitted on the answer's fit rows only"]
+fn devset_extensions_recover_half_the_gap_fitted_where_the_answer_was() {
+    use std::io::Write;
+    let exe = env!("CARGO_BIN_EXE_tyrekit");
+    let Some(v) = devset::run_all("diagnose_devset_fit_rows", |a, work, data| {
+        let lines = devset::read_lines(&a.file);
+        let et = lines[0]
+            .split('\t')
+            .position(|n| n == "ET")
+            .expect("ET column");
+        let path = work.join(format!("{}.dat", a.name));
+        let mut out = std::io::BufWriter::new(std::fs::File::create(&path).expect("cut"));
+        for (i, l) in lines.iter().enumerate() {
+            let keep = i < 2
+                || l.split('\t')
+                    .nth(et)
+                    .and_then(|x| x.trim().parse::<f64>().ok())
+                    .is_some_and(|t| t < a.split_et);
+            if keep {
+                writeln!(out, "{l}").expect("write");
+            }
+        }
+        drop(out);
+        let report = work.join(&a.name);
+        let verdict = diagnose_cli(&a.name, &path, &report);
+        let (effect, pure) = answer_of(data, &a.name);
+        let (channel, ab, at) = gap_channel(&pure);
+        let raw = devset::read_raw(&a.file);
+        let mut nr = [f64::NAN; 2];
+        for (k, f) in ["baseline", "extended"].iter().enumerate() {
+            let sim = report.join(format!("{f}_whole.csv"));
+            replay(exe, &a.file, &report.join(format!("{f}.tir")), &sim);
+            let (figs, _) = devset::figures(a, &raw, &devset::read_sim(&sim));
+            nr[k] = figs
+                .iter()
+                .find(|x| x.group == "pure" && x.channel == channel)
+                .map_or(f64::NAN, |x| x.ours);
+        }
+        (a.name.clone(), effect, verdict, channel, nr, ab, at)
+    }) else {
+        return;
+    };
+    let mut gaps = Vec::new();
+    let mut ratios = Vec::new();
+    for (name, effect, verdict, ch, nr, ab, at) in &v {
+        let gap = (nr[0] - nr[1]) / (ab - at);
+        ratios.push(nr[0] / ab);
+        let right = verdict == effect;
+        if right && effect != "none" {
+            gaps.push(gap);
+        }
+        println!(
+            "fit rows {name} {effect:<17} {verdict:<17} {ch} base.tir {:.5} ext.tir {:.5} ans.base {ab:.5} ans.trth {at:.5} base/ans {:.2} gap {:>6.1} %{}",
+            nr[0],
+            nr[1],
+            nr[0] / ab,
+            100.0 * gap,
+            if right { "  ok" } else { "" }
+        );
+    }
+    let m = median(gaps.clone());
+    let r = median(ratios);
+    let wrong: Vec<&String> = v
+        .iter()
+        .filter(|o| o.2 != "none" && o.2 != o.1)
+        .map(|o| &o.0)
+        .collect();
+    println!(
+        "fit rows: right names {} (controls none: {} of 3), wrong {wrong:?}; median gap over the right names {:.0} %, median baseline.tir / answer baseline {r:.3}",
+        gaps.len(),
+        v.iter().filter(|o| o.1 == "none" && o.2 == "none").count(),
+        100.0 * m
+    );
+    if v.len() < 21 {
+        eprintln!("NOTE partial run: only the per-recording lines are meaningful");
+        return;
+    }
+    assert!(
+        (r - 1.0).abs() <= FIT_ROWS_BASELINE_MATCH,
+        "baseline.tir fitted on the answer's rows replays at {r:.3} × the answer's baseline (median): not a like-for-like comparison"
+    );
+    assert!(
+        gaps.len() >= FIT_ROWS_NAMED_BEFORE,
+        "right names on the fit rows {}, before {FIT_ROWS_NAMED_BEFORE}",
+        gaps.len()
+    );
+    assert!(
+        m >= GAP_MEDIAN_MIN,
+        "median gap over the right names {m:.2} < {GAP_MEDIAN_MIN}"
+    );
+}
+
 /// Every dev-set recording — or, with a `sample` and without
 /// `TYREKIT_DEVSET_VARIATIONS=all`, only the sample's — rewritten by
 /// `rewrite` (it gets the recording's name and its lines — names, units,

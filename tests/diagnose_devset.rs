@@ -186,6 +186,14 @@ fn diagnose_cli(name: &str, rec: &Path, report: &Path) -> String {
     j["verdict"].as_str().expect("verdict").to_string()
 }
 
+/// NRMSE of a replayed `sim.csv` on `channel`'s pure-slip rows of the last 30 %.
+fn pure_nrmse(a: &Answer, raw: &devset::Raw, sim: &Path, channel: &str) -> f64 {
+    let (figs, _) = devset::figures(a, raw, &devset::read_sim(sim));
+    figs.iter()
+        .find(|x| x.group == "pure" && x.channel == channel)
+        .map_or(f64::NAN, |x| x.ours)
+}
+
 fn run(a: &Answer, dir: &Path, data: &Path) -> Outcome {
     let exe = env!("CARGO_BIN_EXE_tyrekit");
     let report = dir.join(&a.name);
@@ -195,12 +203,7 @@ fn run(a: &Answer, dir: &Path, data: &Path) -> Outcome {
     let (effect, pure) = answer_of(data, &a.name);
     let (channel, ab, at) = gap_channel(&pure);
     let raw = devset::read_raw(&a.file);
-    let gap_nrmse = |sim: &Path| {
-        let (figs, _) = devset::figures(a, &raw, &devset::read_sim(sim));
-        figs.iter()
-            .find(|x| x.group == "pure" && x.channel == channel)
-            .map_or(f64::NAN, |x| x.ours)
-    };
+    let gap_nrmse = |sim: &Path| pure_nrmse(a, &raw, sim, &channel);
     let rec = tyrekit::data::Recording::from_file(&a.file).expect("recording");
     let mut nr = [f64::NAN; 2];
     let mut ns = [f64::NAN; 2];
@@ -482,11 +485,7 @@ fn devset_extensions_recover_half_the_gap_fitted_where_the_answer_was() {
         for (k, f) in ["baseline", "extended"].iter().enumerate() {
             let sim = report.join(format!("{f}_whole.csv"));
             replay(exe, &a.file, &report.join(format!("{f}.tir")), &sim);
-            let (figs, _) = devset::figures(a, &raw, &devset::read_sim(&sim));
-            nr[k] = figs
-                .iter()
-                .find(|x| x.group == "pure" && x.channel == channel)
-                .map_or(f64::NAN, |x| x.ours);
+            nr[k] = pure_nrmse(a, &raw, &sim, &channel);
         }
         (a.name.clone(), effect, verdict, channel, nr, ab, at)
     }) else {

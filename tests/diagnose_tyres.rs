@@ -186,6 +186,89 @@ fn the_baseline_fits_controls_of_other_real_tyres_within_the_noise() {
     );
 }
 
+/// The controls of [`TYRES`] again with other seeds of the rig's noise,
+/// scatter and non-uniformity: every verdict `none`. The live test runs one
+/// seed per tyre, and the selection's floor ([`MIN_GAIN`], 2.5 %) was set
+/// above the largest gain a control of it had shown (the MF 5.2 example's
+/// camber, 2.4 %); this asks how often another seed crosses it. Printed per
+/// control: the verdict and the largest held-out gain of any candidate in a
+/// channel where its BIC fell (what the floor is measured against).
+/// `TYREKIT_CONTROL_SEEDS=n` seeds per tyre (default 3: 24 diagnoses,
+/// ≈ 3–6 min on 2 cores). Measured 4 Dec 2026: MF 5.2's seed 3103 named
+/// `camber` (QDZ8 alone, Mz −5.3 % held out, Mz BIC −0.3); since a
+/// candidate made of the baseline's own keys needs positive evidence
+/// (`diagnose::candidate::REFIT_EVIDENCE`) all 24 `none`.
+///
+/// [`MIN_GAIN`]: tyrekit::diagnose::candidate::MIN_GAIN
+#[test]
+#[ignore = "on demand (24 diagnoses, ≈ 6 min): the controls of the live test with other seeds"]
+fn controls_of_other_real_tyres_with_other_seeds_name_nothing() {
+    let tir = common::shared().join("data/tir");
+    if !tir.exists() {
+        eprintln!("SKIP controls_of_other_real_tyres_with_other_seeds_name_nothing: ../shared/data/tir is absent");
+        return;
+    }
+    let seeds: u64 = std::env::var("TYREKIT_CONTROL_SEEDS")
+        .map(|v| v.parse().expect("TYREKIT_CONTROL_SEEDS: a count"))
+        .unwrap_or(3);
+    let tmp = common::scratch("diag-seeds");
+    let dir = tmp.path();
+    let mut named = Vec::new();
+    let mut largest: f64 = 0.0;
+    for (k, (file, _)) in TYRES.iter().enumerate() {
+        let tyre = Tyre::from_file(&tir.join(file)).expect("a shared tyre file");
+        for j in 1..=seeds {
+            let seed = 100 + k as u64 + 1000 * j;
+            let tag = format!("control{k}_{seed}");
+            let rec = dir.join(format!("{tag}.mat"));
+            control(&tyre, seed, &rec);
+            let (_, d) = diagnose(file, &rec, &dir.join(&tag));
+            let best = d["effects"]
+                .as_array()
+                .into_iter()
+                .flatten()
+                .filter(|e| e["name"] != "none")
+                .flat_map(|e| {
+                    e["channels"]
+                        .as_array()
+                        .into_iter()
+                        .flatten()
+                        .filter(|c| {
+                            c["acts"] == true && c["delta_bic"].as_f64().is_some_and(|b| b < 0.0)
+                        })
+                        .map(move |c| {
+                            (
+                                c["oos_gain"].as_f64().unwrap_or(f64::NAN),
+                                format!(
+                                    "{} {}",
+                                    e["name"].as_str().unwrap_or("?"),
+                                    c["channel"].as_str().unwrap_or("?")
+                                ),
+                            )
+                        })
+                })
+                .max_by(|a, b| a.0.total_cmp(&b.0));
+            let verdict = d["verdict"].as_str().unwrap_or("?").to_string();
+            println!(
+                "{file} seed {seed}: {verdict}; largest gain {}",
+                best.as_ref()
+                    .map_or("none".into(), |(g, w)| format!("{:.1} % ({w})", 100.0 * g))
+            );
+            if let Some((g, _)) = &best {
+                largest = largest.max(*g);
+            }
+            if verdict != "none" {
+                named.push(format!(
+                    "{file} seed {seed}: {verdict}: {}",
+                    d["explanation"]
+                ));
+            }
+        }
+    }
+    println!("largest control gain {:.1} %", 100.0 * largest);
+    assert!(named.is_empty(), "controls named: {named:#?}");
+}
+
 /// A control of the all-zero template file (`TIR_template.tir`: every
 /// force coefficient 0, so the rig records noise and zeros only while it
 /// sweeps α to ±12° and κ to ±0.2): both force channels are rejected as

@@ -57,5 +57,6 @@ pub(super) fn candidate() -> ParamCandidate {
                 .join(", ")
         },
         reestimation: Reestimation::No,
+        refits_baseline: true,
     }
 }

@@ -158,5 +158,6 @@ pub(super) fn candidate() -> ParamCandidate {
         spec: load_spec,
         words,
         reestimation: Reestimation::ThroughScales,
+        refits_baseline: false,
     }
 }

@@ -76,5 +76,6 @@ pub(super) fn candidate() -> ParamCandidate {
             )
         },
         reestimation: Reestimation::No,
+        refits_baseline: false,
     }
 }

@@ -67,7 +67,9 @@
 //!   acting on the channel, [`Fitted::parameters_on`]).
 //! * Verdict ([`select`], [`qualifies`]): a candidate qualifies when some
 //!   channel's held-out error falls by more than [`MIN_GAIN`] and that
-//!   channel's own BIC falls (an effect may live in one channel), none rises
+//!   channel's own BIC falls (by [`REFIT_EVIDENCE`] for a candidate made of
+//!   keys the baseline fitted, [`Candidate::refits_baseline`]: camber) (an
+//!   effect may live in one channel), none rises
 //!   by more than [`MAX_LOSS`] (physics that is missing makes no channel
 //!   worse; a candidate that trades one channel for another absorbs a
 //!   misfit), and the pooled held-out and in-sample gains are positive;
@@ -110,7 +112,7 @@ pub use crate::residual::{FX, FY, MZ};
 pub use param::{NoneCandidate, Param, ParamCandidate, ReferenceOf, Spec, Target, STATIC_SAMPLES};
 pub use selection::{
     also_qualifying, channels_in_words, overshadowed, overshadowed_in_words, overshadowed_summary,
-    qualifies, select, why_not, MAX_LOSS, MIN_GAIN, OVERSHADOW,
+    qualifies, select, why_not, MAX_LOSS, MIN_GAIN, OVERSHADOW, REFIT_EVIDENCE,
 };
 pub use statistics::{
     evaluate, every_segment, fit_weights, held_out_sse, refit_on_all, smoothed_inputs, split,
@@ -187,6 +189,15 @@ pub trait Candidate: Send + Sync {
     /// ("transient slip lag"): used in the explanation of a verdict.
     fn physics(&self) -> &'static str {
         self.name()
+    }
+    /// Whether the candidate's parameters are keys the baseline's own fit
+    /// moved (camber: the MF's inclination terms), so that it adds no
+    /// physics the baseline lacks and its gain may come from scoring the
+    /// same keys under the diagnosis's objective instead of the baseline
+    /// fit's: its evidence channel's BIC must then fall by
+    /// [`REFIT_EVIDENCE`] (see `selection`).
+    fn refits_baseline(&self) -> bool {
+        false
     }
     /// How the baseline can be fitted again beneath the extension
     /// ([`crate::diagnose::reestimate`]).

@@ -643,6 +643,8 @@ pub struct ParamCandidate {
     pub words: fn(&dyn Fitted) -> String,
     /// See [`Candidate::reestimation`].
     pub reestimation: Reestimation,
+    /// See [`Candidate::refits_baseline`].
+    pub refits_baseline: bool,
 }
 
 impl Candidate for ParamCandidate {
@@ -657,6 +659,9 @@ impl Candidate for ParamCandidate {
     }
     fn reestimation(&self) -> Reestimation {
         self.reestimation
+    }
+    fn refits_baseline(&self) -> bool {
+        self.refits_baseline
     }
     fn describe(&self, f: &dyn Fitted) -> String {
         let held = f.held();

@@ -108,5 +108,6 @@ pub(super) fn candidate() -> ParamCandidate {
         spec: pressure_spec,
         words,
         reestimation: Reestimation::AtRecordedPressure,
+        refits_baseline: false,
     }
 }

@@ -60,5 +60,6 @@ pub(super) fn candidate() -> ParamCandidate {
             )
         },
         reestimation: Reestimation::ThroughScales,
+        refits_baseline: false,
     }
 }

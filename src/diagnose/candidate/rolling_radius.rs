@@ -47,5 +47,6 @@ pub(super) fn candidate() -> ParamCandidate {
             )
         },
         reestimation: Reestimation::No,
+        refits_baseline: false,
     }
 }

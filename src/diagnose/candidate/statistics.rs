@@ -7,7 +7,7 @@
 //! Must never: let a candidate see the held-out half's forces while
 //! fitting, or count a channel the recording lacks.
 
-use super::{Candidate, Fitted};
+use super::{Candidate, Fitted, REFIT_EVIDENCE};
 use crate::data::Recording;
 use crate::error::Result;
 use crate::mf::{Forces, Tyre};
@@ -54,6 +54,10 @@ pub struct ChannelScore {
     /// gain in a channel the parameters do not act on is a side effect of
     /// the fit and cannot carry the verdict (see `selection`).
     pub acts: bool,
+    /// How far this channel's BIC must fall to carry a verdict: 0 for
+    /// physics the baseline lacks; [`super::REFIT_EVIDENCE`] for a candidate
+    /// made of keys the baseline fitted itself ([`super::Candidate::refits_baseline`]).
+    pub bic_needed: f64,
 }
 
 impl ChannelScore {
@@ -407,6 +411,11 @@ pub fn evaluate(
                                 baseline_misfit: None,
                                 reference_gain: gain(base[1][j].0, sb[1][j].0),
                                 acts: fitted.parameters_on(j) > 0,
+                                bic_needed: if c.refits_baseline() {
+                                    REFIT_EVIDENCE
+                                } else {
+                                    0.0
+                                },
                             })
                             .collect();
                         Ok((

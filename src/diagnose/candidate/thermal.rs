@@ -174,6 +174,7 @@ pub(super) fn candidate() -> ParamCandidate {
             )
         },
         reestimation: Reestimation::ThroughScales,
+        refits_baseline: false,
     }
 }
 

@@ -348,19 +348,16 @@ pub fn why_not(e: &Evaluation) -> Option<String> {
             .map(|c| format!("{} {:+.1}", c.channel.name(), c.delta_bic))
             .collect();
         let needed = e.channels.iter().map(|c| c.bic_needed).fold(0.0, f64::max);
-        if needed > 0.0 {
-            format!(
-                "the gain does not pay for its {} parameters: it fits the baseline's own keys again, so the BIC of a channel that gains must fall by {needed:.0} or more, and none does ({})",
-                e.n_params,
-                bics.join(", ")
-            )
+        let rule = if needed > 0.0 {
+            format!("it fits the baseline's own keys again, so the BIC of a channel that gains must fall by {needed:.0} or more, and none does")
         } else {
-            format!(
-                "the gain does not pay for its {} parameters: the BIC of no channel that gains falls ({})",
-                e.n_params,
-                bics.join(", ")
-            )
-        }
+            "the BIC of no channel that gains falls".to_string()
+        };
+        format!(
+            "the gain does not pay for its {} parameters: {rule} ({})",
+            e.n_params,
+            bics.join(", ")
+        )
     })
 }
 

@@ -205,6 +205,9 @@ pub fn run(a: Args) -> Result<()> {
     let hp = a.report.join("report.html");
     std::fs::write(&hp, html::page(&d, &pl, &rec.source, &note)).map_err(|e| Error::io(&hp, e))?;
     m.say(format_args!("verdict: {}", d.verdict()));
+    if let Some(e) = d.report.verdict_evidence {
+        m.say(format_args!("evidence: {}", e.in_words()));
+    }
     m.say(d.explanation());
     for r in d
         .report

@@ -13,7 +13,7 @@
 //! Must never: call a grouping significant that [`super::locate`] did not,
 //! or state a figure the evaluation does not hold.
 
-use super::candidate::{channels_in_words, why_not, Evaluation, MIN_GAIN};
+use super::candidate::{channels_in_words, evidence, why_not, Evaluation, EvidenceGrade, MIN_GAIN};
 use super::locate::Finding;
 use super::quality::QualityRow;
 use crate::residual::Channel;
@@ -181,7 +181,7 @@ pub fn explain(
     };
     match verdict {
         Some(e) => format!(
-            "{}. Missing from the model: {}. Fitted: {}. This removes {:.0} % of the baseline's error on held-out segments (each channel's squared error: {}; BIC {:+.1}).{}",
+            "{}. Missing from the model: {}. Fitted: {}. This removes {:.0} % of the baseline's error on held-out segments (each channel's squared error: {}; BIC {:+.1}).{}{}",
             capitalise(located.as_deref().unwrap_or(
                 "no single grouping of the residual is significant on its own"
             )),
@@ -190,7 +190,8 @@ pub fn explain(
             100.0 * e.oos_gain,
             channels_in_words(e),
             e.delta_bic,
-            at_bound_note(e)
+            at_bound_note(e),
+            weak_evidence_note(e)
         ),
         None => {
             let best = best_other.map_or("no candidate was evaluated".to_string(), |b| {
@@ -313,6 +314,20 @@ pub(crate) fn at_bound_note(e: &Evaluation) -> String {
     )
 }
 
+/// A caution when the verdict rests on weak evidence ([`evidence`]: the
+/// channel that carries it lowers its BIC by 2 or less, "not worth more
+/// than a bare mention" on Kass & Raftery's scale); empty otherwise.
+pub(crate) fn weak_evidence_note(e: &Evaluation) -> String {
+    match evidence(e) {
+        Some(w) if w.grade == EvidenceGrade::Weak => format!(
+            " The evidence is weak: the channel that carries it, {}, lowers its BIC by only {:.1} (2 or less is \"not worth more than a bare mention\" on Kass & Raftery's scale), so the name rests on a small held-out gain; a repeat of the run, or a longer programme, would confirm or refute it.",
+            w.channel.name(),
+            w.bic_fall
+        ),
+        _ => String::new(),
+    }
+}
+
 /// Relative rise of a channel's held-out σ above which the verdict's
 /// explanation carries a caution (10 %: well above the run-to-run scatter
 /// of σ between the halves, far below what a real improvement shows).
@@ -409,6 +424,51 @@ mod tests {
         let unknown = explain(&lag(f64::NAN), None, None, 0.05, false, None);
         assert!(!unknown.contains("Nothing is missing"), "{unknown}");
         assert!(!unknown.contains("% of its squares"), "{unknown}");
+    }
+
+    /// A verdict that rests on a channel whose BIC falls by 2 or less says
+    /// the evidence is weak, with the channel and the fall; one that falls
+    /// by 9 does not.
+    #[test]
+    fn a_verdict_on_weak_evidence_says_so() {
+        use crate::diagnose::candidate::ChannelScore;
+        let verdict = |bic: f64| Evaluation {
+            name: "thermal".into(),
+            n_params: 5,
+            oos_gain: 0.02,
+            fit_gain: 0.03,
+            delta_bic: 18.8,
+            channels: vec![ChannelScore {
+                channel: Channel::Mz,
+                n: 20000,
+                oos_gain: 0.033,
+                fit_gain: 0.079,
+                delta_bic: bic,
+                baseline_misfit: None,
+                reference_gain: 0.0,
+                acts: true,
+                bic_needed: 0.0,
+            }],
+            parameters: vec![],
+            at_bound: vec![],
+            physics: "a tread temperature".into(),
+            describe: "a heat capacity".into(),
+            reference_gain: 0.0,
+            rank_bic: 18.8,
+        };
+        let weak = explain(&lag(0.0027), Some(&verdict(-0.6)), None, 0.05, false, None);
+        assert!(
+            weak.contains(
+                "The evidence is weak: the channel that carries it, Mz, lowers its BIC by only 0.6"
+            ),
+            "{weak}"
+        );
+        let strong = explain(&lag(0.0027), Some(&verdict(-9.0)), None, 0.05, false, None);
+        assert!(
+            strong.contains("Missing from the model: a tread temperature"),
+            "{strong}"
+        );
+        assert!(!strong.contains("evidence is weak"), "{strong}");
     }
 
     /// A pressure that drifts with time alone: nothing named is said only

@@ -88,8 +88,12 @@ td:first-child,th:first-child,td:nth-child(2){{text-align:left}} tr.all{{font-we
 tr.sig{{background:#fff4e0}} td.good{{color:#080}} figure{{margin:1.5em 0}} img{{max-width:100%;border:1px solid #ddd}}\
 figcaption{{font-size:.9em;color:#444}} details{{margin:1em 0}}\
 </style></head><body>\n<h1>Diagnosis of {src}</h1>\n\
-<p class=\"verdict\">Verdict: <b>{v}</b></p>\n<p>{ex}</p>\n<p><small>{bn}</small></p>\n",
+<p class=\"verdict\">Verdict: <b>{v}</b>{ev}</p>\n<p>{ex}</p>\n<p><small>{bn}</small></p>\n",
         v = esc(d.verdict()),
+        ev = d
+            .report
+            .verdict_evidence
+            .map_or(String::new(), |e| format!(" — evidence {}", esc(&e.in_words()))),
         src = esc(source),
         ex = esc(d.explanation()),
         bn = esc(baseline_note),

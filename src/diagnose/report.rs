@@ -32,8 +32,8 @@
 
 use super::candidate::param::rerolled;
 use super::candidate::{
-    all, also_qualifying, channels_in_words, evaluate, overshadowed_in_words, overshadowed_summary,
-    select, why_not, Candidate, ChannelScore,
+    all, also_qualifying, channels_in_words, evaluate, evidence, overshadowed_in_words,
+    overshadowed_summary, select, why_not, Candidate, ChannelScore, Evidence,
 };
 use super::locate::{frictional_energy, locate, Finding, LocateOptions, Residuals};
 use super::reestimate::{build_extended, FileOf, Refit};
@@ -169,6 +169,12 @@ pub struct DiagnosisReport {
     pub verdict: String,
     /// The verdict, its evidence and its caveats in words.
     pub explanation: String,
+    /// The channel that carries the verdict's evidence and its grade
+    /// ([`crate::diagnose::candidate::evidence`]); absent without a
+    /// candidate verdict (`none`, or `rolling_radius` named from the slip
+    /// channel, whose evidence is that channel).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub verdict_evidence: Option<Evidence>,
     /// Other candidates that also qualify ([`also_qualifying`]), lowest
     /// BIC first: findings the data support besides the verdict.
     pub also_qualifying: Vec<String>,
@@ -592,6 +598,7 @@ pub fn diagnose_with(
     let report = DiagnosisReport {
         verdict: verdict.clone(),
         explanation,
+        verdict_evidence: verdict_i.and_then(|i| evidence(&ev[i].0)),
         also_qualifying: also.iter().map(|&i| ev[i].0.name.clone()).collect(),
         effects,
         quality: QualityReport {

@@ -111,8 +111,9 @@ pub mod work;
 pub use crate::residual::{FX, FY, MZ};
 pub use param::{NoneCandidate, Param, ParamCandidate, ReferenceOf, Spec, Target, STATIC_SAMPLES};
 pub use selection::{
-    also_qualifying, channels_in_words, overshadowed, overshadowed_in_words, overshadowed_summary,
-    qualifies, select, why_not, MAX_LOSS, MIN_GAIN, OVERSHADOW, REFIT_EVIDENCE,
+    also_qualifying, channels_in_words, evidence, overshadowed, overshadowed_in_words,
+    overshadowed_summary, qualifies, select, why_not, Evidence, EvidenceGrade, MAX_LOSS, MIN_GAIN,
+    OVERSHADOW, REFIT_EVIDENCE,
 };
 pub use statistics::{
     evaluate, every_segment, fit_weights, held_out_sse, refit_on_all, smoothed_inputs, split,

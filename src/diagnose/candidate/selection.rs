@@ -237,6 +237,96 @@ pub fn overshadowed_summary(ev: &[(Evaluation, Box<dyn Fitted>)]) -> Option<Stri
     (!sentences.is_empty()).then(|| sentences.join(" "))
 }
 
+/// How strongly the data support a named effect: Kass & Raftery's grades of
+/// 2 ln B (*JASA* 90, 1995, §3.2), with 2 ln B read as the BIC fall of the
+/// channel that carries the verdict (Schwarz's approximation, −ΔBIC ≈
+/// 2 ln B; see [`evidence`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EvidenceGrade {
+    /// A BIC fall of 2 or less: "not worth more than a bare mention".
+    Weak,
+    /// Over 2 and up to 6.
+    Positive,
+    /// Over 6 and up to 10.
+    Strong,
+    /// Over 10.
+    VeryStrong,
+}
+
+impl EvidenceGrade {
+    /// The grade of a BIC fall (positive = the model with the effect is
+    /// preferred).
+    pub fn of(bic_fall: f64) -> Self {
+        if bic_fall > 10.0 {
+            Self::VeryStrong
+        } else if bic_fall > 6.0 {
+            Self::Strong
+        } else if bic_fall > 2.0 {
+            Self::Positive
+        } else {
+            Self::Weak
+        }
+    }
+
+    /// The grade in words ("very strong").
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Weak => "weak",
+            Self::Positive => "positive",
+            Self::Strong => "strong",
+            Self::VeryStrong => "very strong",
+        }
+    }
+}
+
+/// The channel that carries a named effect's evidence, and how strong it is.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Evidence {
+    /// The channel (written as its key, "MZ").
+    pub channel: Channel,
+    /// How far that channel's BIC falls with the effect (positive = better;
+    /// −[`ChannelScore::delta_bic`]).
+    pub bic_fall: f64,
+    /// Its grade on Kass & Raftery's scale.
+    pub grade: EvidenceGrade,
+}
+
+impl Evidence {
+    /// The grade, the channel and its BIC change in words ("weak: Mz BIC
+    /// −0.6 on Kass & Raftery's scale").
+    pub fn in_words(&self) -> String {
+        format!(
+            "{}: {} BIC {:+.1} on Kass & Raftery's scale",
+            self.grade.name(),
+            self.channel.name(),
+            -self.bic_fall
+        )
+    }
+}
+
+/// The evidence behind `e` as a verdict: of the channels that show the
+/// effect (held-out gain over [`MIN_GAIN`], BIC falling, the baseline not
+/// misfitting there, the parameters acting on it), the one whose BIC falls
+/// most. None when no channel shows it (`e` does not qualify). The rule
+/// names an effect on any fall of that BIC (by [`REFIT_EVIDENCE`] for a
+/// refit of the baseline's own keys), so a verdict may rest on weak
+/// evidence — a dev-set recording cut at 70 % of its run named `thermal` on
+/// a Mz BIC fall of 0.6; a bar of 2 for every candidate had refused a right
+/// name under other sensor noise (r03, Fy 0.8) — and the words say so
+/// instead (the explanation and `verdict_evidence` of `diagnosis.json`).
+pub fn evidence(e: &Evaluation) -> Option<Evidence> {
+    e.channels
+        .iter()
+        .filter(|c| shows(c))
+        .min_by(|a, b| a.delta_bic.total_cmp(&b.delta_bic))
+        .map(|c| Evidence {
+            channel: c.channel,
+            bic_fall: -c.delta_bic,
+            grade: EvidenceGrade::of(-c.delta_bic),
+        })
+}
+
 /// The other qualifying candidates ([`qualifies`]) besides the verdict
 /// `winner`, lowest pooled BIC first: findings the data also support. Two
 /// candidates that both qualify each explain part of the same residual (a
@@ -412,6 +502,48 @@ mod tests {
             )
             .unwrap();
         (e, none)
+    }
+
+    /// The evidence is read from the channel whose BIC falls most among
+    /// those that show the effect, and graded on Kass & Raftery's scale: a
+    /// fall of 0.6 is weak, 3 positive, 8 strong, 150 very strong; a channel
+    /// that gains without acting, or a candidate that shows nothing, carries
+    /// none.
+    #[test]
+    fn the_evidence_is_the_strongest_showing_channel_graded() {
+        let e = ev(
+            &[
+                (Channel::Fx, -0.006, 26.0),
+                (Channel::Fy, 0.015, 23.6),
+                (Channel::Mz, 0.033, -0.6),
+            ],
+            0.02,
+            18.8,
+        );
+        let w = evidence(&e).expect("Mz shows the effect");
+        assert_eq!(w.channel, Channel::Mz);
+        assert!((w.bic_fall - 0.6).abs() < 1e-12);
+        assert_eq!(w.grade, EvidenceGrade::Weak);
+        let e = ev(
+            &[(Channel::Fy, 0.05, -3.0), (Channel::Mz, 0.30, -150.0)],
+            0.2,
+            -140.0,
+        );
+        assert_eq!(evidence(&e).unwrap().channel, Channel::Mz);
+        assert_eq!(evidence(&e).unwrap().grade, EvidenceGrade::VeryStrong);
+        for (fall, grade) in [
+            (2.0, EvidenceGrade::Weak),
+            (3.0, EvidenceGrade::Positive),
+            (8.0, EvidenceGrade::Strong),
+            (10.5, EvidenceGrade::VeryStrong),
+        ] {
+            assert_eq!(EvidenceGrade::of(fall), grade, "fall {fall}");
+        }
+        let mut off = ev(&[(Channel::Mz, 0.05, -20.0)], 0.05, -20.0);
+        off.channels[0].acts = false;
+        assert_eq!(evidence(&off), None);
+        let small = ev(&[(Channel::Fy, 0.01, -5.0)], 0.01, -5.0);
+        assert_eq!(evidence(&small), None);
     }
 
     /// The real-data case of the old rule: a large gain on the badly fitted

@@ -444,7 +444,8 @@ fn effects_on_other_tyres_get_no_wrong_name() {
             let (_, d) = diagnose(file, &rec, &dir.join(&tag));
             let verdict = d["verdict"].as_str().unwrap_or("?").to_string();
             let programme = if speeds { "3 speeds" } else { "1 speed" };
-            println!("{file} ({why}) | {effect} | {programme} | {verdict}");
+            let grade = d["verdict_evidence"]["grade"].as_str().unwrap_or("-");
+            println!("{file} ({why}) | {effect} | {programme} | {verdict} | evidence {grade}");
             if effect != "none" {
                 concealed += 1;
                 named += usize::from(verdict == effect);

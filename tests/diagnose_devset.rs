@@ -167,6 +167,16 @@ fn replay(exe: &str, rec: &Path, tir: &Path, out: &Path) {
 
 /// `tyrekit diagnose REC --report DIR` as a user runs it; the verdict.
 fn diagnose_cli(name: &str, rec: &Path, report: &Path) -> String {
+    verdict_of(&diagnose_json(name, rec, report))
+}
+
+/// The verdict of a `diagnosis.json`.
+fn verdict_of(j: &serde_json::Value) -> String {
+    j["verdict"].as_str().expect("verdict").to_string()
+}
+
+/// `tyrekit diagnose REC --report DIR` as a user runs it; its `diagnosis.json`.
+fn diagnose_json(name: &str, rec: &Path, report: &Path) -> serde_json::Value {
     let o = Command::new(env!("CARGO_BIN_EXE_tyrekit"))
         .arg("diagnose")
         .arg(rec)
@@ -179,11 +189,10 @@ fn diagnose_cli(name: &str, rec: &Path, report: &Path) -> String {
         "{name}: tyrekit diagnose failed: {}",
         String::from_utf8_lossy(&o.stderr)
     );
-    let j: serde_json::Value = serde_json::from_str(
+    serde_json::from_str(
         &std::fs::read_to_string(report.join("diagnosis.json")).expect("diagnosis.json"),
     )
-    .expect("diagnosis.json is JSON");
-    j["verdict"].as_str().expect("verdict").to_string()
+    .expect("diagnosis.json is JSON")
 }
 
 /// NRMSE of a replayed `sim.csv` on `channel`'s pure-slip rows of the last 30 %.
@@ -480,11 +489,8 @@ fn devset_extensions_recover_half_the_gap_fitted_where_the_answer_was() {
         }
         drop(out);
         let report = work.join(&a.name);
-        let verdict = diagnose_cli(&a.name, &path, &report);
-        let j: serde_json::Value = serde_json::from_str(
-            &std::fs::read_to_string(report.join("diagnosis.json")).expect("diagnosis.json"),
-        )
-        .expect("diagnosis.json is JSON");
+        let j = diagnose_json(&a.name, &path, &report);
+        let verdict = verdict_of(&j);
         let weak = j["verdict_evidence"]["grade"] == "weak"
             && j["explanation"]
                 .as_str()
